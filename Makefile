@@ -1,0 +1,58 @@
+# skin_control: `make demo` (main job), `make test` (every test suite), `make bench` (figures).
+# Each target bootstraps what is missing first (scripts/bootstrap: apt, .deps/venv, MuJoCo).
+SHELL := /bin/bash
+.SHELLFLAGS := -eo pipefail -c
+TOP := $(CURDIR)
+DEPS := $(TOP)/.deps
+ENV := source $(DEPS)/env.sh &&
+MSGS_STAMP := $(DEPS)/ros/install/share/skin_msgs/package.xml
+MSG_SRCS := $(wildcard skin_msgs/msg/*.msg skin_msgs/srv/*.srv) skin_msgs/CMakeLists.txt skin_msgs/package.xml
+CARGO_PROFILE ?= dev
+
+.PHONY: help bootstrap msgs build test test-rust test-integration demo bench clean
+
+help:
+	@echo "make demo   bootstrap, build, run the main job (see README.md)"
+	@echo "make test   bootstrap, build, run every test suite (cargo tests + test/ integration tests)"
+	@echo "make bench  run the benchmarks; figures in out/bench/summary.json"
+	@echo "make clean  remove build outputs (keeps .deps; rm -rf .deps for a full reset)"
+
+bootstrap:
+	@scripts/bootstrap
+
+# skin_msgs: ament_cmake interface package, built by colcon into .deps/ros/install (C + Python typesupport).
+$(MSGS_STAMP): $(MSG_SRCS) | bootstrap
+	@echo "[make] colcon build skin_msgs"
+	@mkdir -p $(DEPS)/ros
+	@$(ENV) cd $(DEPS)/ros && colcon build --base-paths $(TOP)/skin_msgs --merge-install \
+	    --build-base build --install-base install --event-handlers console_cohesion- console_stderr- \
+	    --cmake-args -DPython3_EXECUTABLE=$(DEPS)/venv/bin/python -DBUILD_TESTING=OFF \
+	    > $(DEPS)/ros/colcon.log 2>&1 || { tail -40 $(DEPS)/ros/colcon.log; echo "colcon build of skin_msgs failed; full log: .deps/ros/colcon.log"; exit 1; }
+	@touch $@
+
+msgs: bootstrap $(MSGS_STAMP)
+
+build: msgs
+	@echo "[make] cargo build (workspace, all targets)"
+	@$(ENV) cargo build --workspace --all-targets --quiet
+
+test-rust: build
+	@echo "[make] cargo test (workspace)"
+	@$(ENV) cargo test --workspace --quiet 2>&1 | tee $(DEPS)/cargo-test.log
+
+test-integration: build
+	@echo "[make] integration tests (test/, pytest with rclpy, rosbags, pinocchio, MuJoCo as outside peers)"
+	@$(ENV) SKIN_TARGET_DIR=$(TOP)/target/debug python -m pytest -q test
+
+test: test-rust test-integration
+	@echo "[make] all test suites passed"
+
+demo: build
+	@$(ENV) scripts/demo
+
+bench: build
+	@$(ENV) scripts/bench
+
+clean:
+	cargo clean
+	rm -rf $(DEPS)/ros out

@@ -1,0 +1,49 @@
+//! Relays `skin_msgs/SkinCellArray` from one topic to another through r2r's Rust types: the
+//! smallest r2r node of the project, used by the interoperability test (rclpy publishes, this
+//! node decodes and re-encodes every field, rclpy checks what comes back).
+//!
+//! `skin_cells_relay --input /skin/cells_in --output /skin/cells_out [--count N]`
+use anyhow::Result;
+use clap::Parser;
+use futures::{executor::LocalPool, task::LocalSpawnExt, StreamExt};
+use r2r::skin_msgs::msg::SkinCellArray;
+use skin_control::qos;
+
+#[derive(Parser)]
+#[command(about = "Relay skin_msgs/SkinCellArray between two topics (r2r interop check)")]
+struct Args {
+    /// Topic to subscribe to.
+    #[arg(long, default_value = "/skin/cells_in")]
+    input: String,
+    /// Topic to publish on.
+    #[arg(long, default_value = "/skin/cells_out")]
+    output: String,
+    /// Exit after relaying this many messages (0: run until interrupted).
+    #[arg(long, default_value_t = 0)]
+    count: usize,
+}
+
+fn main() -> Result<()> {
+    let args = Args::parse();
+    let ctx = r2r::Context::create()?;
+    let mut node = r2r::Node::create(ctx, "skin_cells_relay", "")?;
+    let mut sub = node.subscribe::<SkinCellArray>(&args.input, qos::stream())?;
+    let publisher = node.create_publisher::<SkinCellArray>(&args.output, qos::stream())?;
+    let relayed = std::rc::Rc::new(std::cell::Cell::new(0usize));
+    let mut pool = LocalPool::new();
+    let counter = relayed.clone();
+    pool.spawner().spawn_local(async move {
+        while let Some(msg) = sub.next().await {
+            if let Err(e) = publisher.publish(&msg) {
+                eprintln!("skin_cells_relay: publish on {} failed: {e}", "output");
+            }
+            counter.set(counter.get() + 1);
+        }
+    })?;
+    println!("skin_cells_relay: {} -> {}", args.input, args.output);
+    while args.count == 0 || relayed.get() < args.count {
+        node.spin_once(std::time::Duration::from_millis(10));
+        pool.run_until_stalled();
+    }
+    Ok(())
+}

@@ -1,0 +1,13 @@
+//! QoS profiles used across the nodes, named for what they carry.
+use r2r::QosProfile;
+
+/// Streams of sensor data and commands: reliable, a short history (a late sample is worth less
+/// than the next one, but tests and bag replay must not lose samples to best-effort delivery).
+pub fn stream() -> QosProfile {
+    QosProfile::default().reliable().keep_last(10)
+}
+
+/// State that a late joiner must still get (the active arrangement): reliable, transient local.
+pub fn latched() -> QosProfile {
+    QosProfile::default().reliable().keep_last(1).transient_local()
+}

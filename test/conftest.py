@@ -1,0 +1,79 @@
+"""Shared fixtures of the topic-level integration tests: where the built binaries are, and
+processes that are always stopped when a test ends."""
+import os
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+TOP = Path(__file__).resolve().parent.parent
+
+
+def target_dir() -> Path:
+    """Cargo's output directory of the build under test (`make test` sets SKIN_TARGET_DIR)."""
+    return Path(os.environ.get("SKIN_TARGET_DIR", TOP / "target" / "debug"))
+
+
+def binary(name: str) -> Path:
+    """Path of a built binary or example; fails the test with a hint when it is missing."""
+    for cand in (target_dir() / name, target_dir() / "examples" / name):
+        if cand.is_file():
+            return cand
+    pytest.fail(f"{name} is not built in {target_dir()}: run `make build` first")
+
+
+@pytest.fixture
+def spawn():
+    """Start processes for one test; every one of them is terminated (then killed) at the end."""
+    procs = []
+
+    def _spawn(*args, **kw):
+        p = subprocess.Popen([str(a) for a in args], stdout=subprocess.PIPE,
+                             stderr=subprocess.STDOUT, text=True, **kw)
+        procs.append(p)
+        return p
+
+    yield _spawn
+    for p in procs:
+        if p.poll() is None:
+            p.terminate()
+    for p in procs:
+        try:
+            p.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.wait()
+
+
+@pytest.fixture
+def rclpy_node(request):
+    """An rclpy node (the outside peer) with its own context, destroyed after the test."""
+    import rclpy
+    from rclpy.context import Context
+
+    ctx = Context()
+    rclpy.init(context=ctx)
+    node = rclpy.create_node(f"peer_{request.node.name[:40]}".replace("[", "_").replace("]", "_")
+                             .replace("-", "_"), context=ctx)
+    yield node
+    node.destroy_node()
+    rclpy.shutdown(context=ctx)
+
+
+def spin_until(node, predicate, timeout_s: float, what: str):
+    """Spin `node` until `predicate()` holds; fail naming `what` after `timeout_s` (a bound on a
+    wait for an event, not a timing assertion)."""
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+
+    ex = SingleThreadedExecutor(context=node.context)
+    ex.add_node(node)
+    deadline = time.monotonic() + timeout_s
+    try:
+        while not predicate():
+            if time.monotonic() > deadline:
+                pytest.fail(f"timed out after {timeout_s} s waiting for {what}")
+            ex.spin_once(timeout_sec=0.05)
+    finally:
+        ex.remove_node(node)

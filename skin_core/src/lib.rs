@@ -1,0 +1,15 @@
+//! `skin_core`: the control law of skin_control, written once and used unchanged by the
+//! simulation loop, the ROS 2 nodes and the benchmarks. Pure Rust: no ROS, no MuJoCo.
+//!
+//! - [`model`]: the immutable [`model::RobotModel`] built from a URDF and the preallocated
+//!   [`model::ModelData`] workspace that kinematics and dynamics (CRBA, RNEA) fill.
+//! - [`skin`]: skin layouts, the cells' signal characteristics and the aggregation of cells into
+//!   forces, patch wrenches and joint torques.
+//! - [`hierarchy`]: the multi-priority torque solver (paper 003 eq. 19-25, with paper 000's
+//!   task-space force levels): ordered [`hierarchy::TaskLevel`]s and a posture torque in, joint
+//!   torque out, with damped, rank-aware inverses.
+#![warn(missing_docs)]
+
+pub mod hierarchy;
+pub mod model;
+pub mod skin;

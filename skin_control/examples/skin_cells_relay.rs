@@ -32,10 +32,11 @@ fn main() -> Result<()> {
     let relayed = std::rc::Rc::new(std::cell::Cell::new(0usize));
     let mut pool = LocalPool::new();
     let counter = relayed.clone();
+    let output = args.output.clone();
     pool.spawner().spawn_local(async move {
         while let Some(msg) = sub.next().await {
             if let Err(e) = publisher.publish(&msg) {
-                eprintln!("skin_cells_relay: publish on {} failed: {e}", "output");
+                eprintln!("skin_cells_relay: publish on {output} failed: {e}");
             }
             counter.set(counter.get() + 1);
         }

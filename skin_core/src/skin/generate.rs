@@ -1,0 +1,248 @@
+//! Building a [`SkinLayout`] by tiling the collision primitives of chosen links of a robot model
+//! (the library side of the `skin_layout` command; geometry in [`super::tiling`]).
+
+use std::str::FromStr;
+
+use nalgebra::{Isometry3, Point3};
+use thiserror::Error;
+
+use super::layout::{CellSpec, PatchSpec, SkinLayout};
+use super::tiling::{tile_box, tile_cylinder, tile_sphere, Face, TiledCell};
+use crate::model::{RobotModel, Shape};
+
+/// A link to cover, optionally restricted to some of its collision elements.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LinkSelection {
+    /// URDF link name.
+    pub link: String,
+    /// Indices of the link's `<collision>` elements to tile (document order); `None` = all.
+    pub collisions: Option<Vec<usize>>,
+}
+
+impl FromStr for LinkSelection {
+    type Err = String;
+    /// Parses `name` (all collision elements) or `name:i+j+...` (only elements i, j, ...).
+    fn from_str(s: &str) -> Result<Self, String> {
+        let s = s.trim();
+        match s.split_once(':') {
+            None if !s.is_empty() => Ok(LinkSelection {
+                link: s.to_string(),
+                collisions: None,
+            }),
+            Some((link, idx)) if !link.is_empty() => {
+                let collisions = idx
+                    .split('+')
+                    .map(|i| {
+                        i.trim()
+                            .parse::<usize>()
+                            .map_err(|_| format!("bad collision index `{i}` in `{s}`"))
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                Ok(LinkSelection {
+                    link: link.to_string(),
+                    collisions: Some(collisions),
+                })
+            }
+            _ => Err(format!(
+                "bad link selection `{s}` (use `link` or `link:0+2`)"
+            )),
+        }
+    }
+}
+
+/// Where the patch frame of a link is put.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PatchFrame {
+    /// At the link frame.
+    Link,
+    /// At the origin of the link's first tiled collision primitive (default): moments of the
+    /// patch wrench are then about the primitive's centre.
+    #[default]
+    Primitive,
+}
+
+/// What to generate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GeneratorSpec {
+    /// Links to cover, in patch order. A link listed twice is one patch.
+    pub links: Vec<LinkSelection>,
+    /// Cell centre distance \[m\].
+    pub pitch_m: f64,
+    /// Box faces to tile per link (links not listed: all six faces).
+    pub faces: Vec<(String, Vec<Face>)>,
+    /// Tile spheres too.
+    pub spheres: bool,
+    /// Placement of the patch frames.
+    pub patch_frame: PatchFrame,
+}
+
+/// Errors of [`generate_layout`].
+#[derive(Debug, Error)]
+pub enum GenerateError {
+    /// The pitch is not finite and positive.
+    #[error("pitch {0} m must be finite and > 0")]
+    BadPitch(f64),
+    /// The link is not in the URDF.
+    #[error("{urdf}: unknown link `{link}`")]
+    UnknownLink {
+        /// URDF file.
+        urdf: String,
+        /// Link name.
+        link: String,
+    },
+    /// A collision index beyond the link's collision elements.
+    #[error("{urdf}: link `{link}` has {count} collision element(s), no index {index}")]
+    BadCollisionIndex {
+        /// URDF file.
+        urdf: String,
+        /// Link name.
+        link: String,
+        /// Requested index.
+        index: usize,
+        /// Number of collision elements.
+        count: usize,
+    },
+    /// Nothing could be tiled on a link.
+    #[error("{urdf}: link `{link}`: no cells fit on its selected primitives at this pitch")]
+    NoCells {
+        /// URDF file.
+        urdf: String,
+        /// Link name.
+        link: String,
+    },
+}
+
+fn tile_shape(shape: &Shape, faces: &[Face], spheres: bool, pitch: f64) -> Vec<TiledCell> {
+    match shape {
+        Shape::Box { size } => tile_box(size, faces, pitch),
+        Shape::Cylinder { radius, length } | Shape::Capsule { radius, length } => {
+            tile_cylinder(*radius, *length, pitch)
+        }
+        Shape::Sphere { radius } if spheres => tile_sphere(*radius, pitch),
+        Shape::Sphere { .. } | Shape::Mesh { .. } => Vec::new(),
+    }
+}
+
+/// Tiles the selected links of `model` (see [`super::tiling`] for the rules). Patch ids and
+/// cell ids count from 1 in output order; deterministic for a given model and spec.
+pub fn generate_layout(
+    model: &RobotModel,
+    spec: &GeneratorSpec,
+) -> Result<SkinLayout, GenerateError> {
+    if !(spec.pitch_m.is_finite() && spec.pitch_m > 0.0) {
+        return Err(GenerateError::BadPitch(spec.pitch_m));
+    }
+    let urdf = model.source().to_string();
+    // Merge repeated links, keeping the first-mention order.
+    let mut order: Vec<(String, Vec<usize>)> = Vec::new();
+    for sel in &spec.links {
+        let frame = model
+            .frame_index(&sel.link)
+            .ok_or_else(|| GenerateError::UnknownLink {
+                urdf: urdf.clone(),
+                link: sel.link.clone(),
+            })?;
+        let count = model.link_collisions(frame).len();
+        let idx: Vec<usize> = match &sel.collisions {
+            None => (0..count).collect(),
+            Some(v) => v.clone(),
+        };
+        if let Some(&index) = idx.iter().find(|&&i| i >= count) {
+            return Err(GenerateError::BadCollisionIndex {
+                urdf,
+                link: sel.link.clone(),
+                index,
+                count,
+            });
+        }
+        match order.iter_mut().find(|(l, _)| *l == sel.link) {
+            Some((_, v)) => {
+                for i in idx {
+                    if !v.contains(&i) {
+                        v.push(i);
+                    }
+                }
+            }
+            None => order.push((sel.link.clone(), idx)),
+        }
+    }
+    let mut layout = SkinLayout {
+        source: urdf.clone(),
+        robot: Some(model.name().to_string()),
+        ..Default::default()
+    };
+    let mut next_cell = 1u32;
+    for (k, (link, idx)) in order.iter().enumerate() {
+        let frame = model.frame_index(link).expect("checked above");
+        let collisions = model.link_collisions(frame);
+        let faces: &[Face] = spec
+            .faces
+            .iter()
+            .find(|(l, _)| l == link)
+            .map(|(_, f)| f.as_slice())
+            .unwrap_or(&Face::ALL);
+        let link_from_patch = match (spec.patch_frame, idx.first()) {
+            (PatchFrame::Primitive, Some(&i)) => collisions[i].origin,
+            _ => Isometry3::identity(),
+        };
+        let patch_id = k as u32 + 1;
+        let first_cell = layout.cells.len();
+        for &i in idx {
+            let c = &collisions[i];
+            let patch_from_primitive = link_from_patch.inverse() * c.origin;
+            for cell in tile_shape(&c.shape, faces, spec.spheres, spec.pitch_m) {
+                let p = patch_from_primitive * Point3::from(cell.position);
+                let n = patch_from_primitive.rotation * cell.normal;
+                layout.cells.push(CellSpec {
+                    id: next_cell,
+                    patch: patch_id,
+                    position: [p.x, p.y, p.z],
+                    normal: [n.x, n.y, n.z],
+                    line: None,
+                });
+                next_cell += 1;
+            }
+        }
+        if layout.cells.len() == first_cell {
+            return Err(GenerateError::NoCells {
+                urdf,
+                link: link.clone(),
+            });
+        }
+        let (roll, pitch, yaw) = link_from_patch.rotation.euler_angles();
+        let t = link_from_patch.translation.vector;
+        layout.patches.push(PatchSpec {
+            id: patch_id,
+            link: link.clone(),
+            xyz: [t.x, t.y, t.z],
+            rpy: [roll, pitch, yaw],
+            line: None,
+        });
+    }
+    Ok(layout)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parse_link_selection() {
+        assert_eq!(
+            "a".parse::<LinkSelection>().unwrap(),
+            LinkSelection {
+                link: "a".into(),
+                collisions: None
+            }
+        );
+        assert_eq!(
+            "arm:0+2".parse::<LinkSelection>().unwrap(),
+            LinkSelection {
+                link: "arm".into(),
+                collisions: Some(vec![0, 2])
+            }
+        );
+        assert!(":1".parse::<LinkSelection>().is_err());
+        assert!("a:x".parse::<LinkSelection>().is_err());
+    }
+}

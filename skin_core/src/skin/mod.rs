@@ -1,0 +1,26 @@
+//! Robot skin: layouts, cell signal characteristics, aggregation into forces and torques.
+//!
+//! Data flow per control cycle (no allocation after setup):
+//! 1. [`signals::CellReading`] per cell (indexed like [`layout::ResolvedLayout::cells`]);
+//! 2. [`aggregate::aggregate_patches`]: paper 003 eq. (6)-(8), patch wrenches in patch frames;
+//! 3. [`transforms`]: paper 003 eq. (11) (forces into a hand frame) and eq. (13) (world wrench);
+//! 4. [`cell_forces`]: paper 000 eq. (3) repulsion and contact forces per cell, in world frame;
+//! 5. [`torques`]: `J^T F` over cells (paper 000 eq. (4), (6)) and patches (paper 003 eq. (14)).
+//!
+//! Setup: [`layout::SkinLayout::load`] + `resolve` against the robot model,
+//! [`params::SkinParams::load`] for the characteristics ([`characteristic`]) and gains.
+//! [`tiling`] holds the geometry of the `skin_layout` generator.
+
+pub mod aggregate;
+pub mod cell_forces;
+pub mod characteristic;
+pub mod generate;
+pub mod layout;
+pub mod params;
+pub mod repulsion;
+pub mod resolved;
+pub mod signals;
+pub mod tiling;
+pub mod torques;
+pub mod transforms;
+pub mod yaml;

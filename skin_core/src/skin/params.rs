@@ -1,0 +1,174 @@
+//! Skin model parameters (`config/skin_model.yaml`): cell characteristics, fusion and repulsion,
+//! loaded and validated with errors naming the file and the key.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use super::aggregate::FusionParams;
+use super::characteristic::{ForceCharacteristic, ProximityCharacteristic};
+use super::repulsion::RepulsionParams;
+use super::yaml::{self, YamlError};
+
+/// A parameter with an invalid value; `key` is its dotted path in the file.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("`{key}` = {value}: {reason}")]
+pub struct InvalidParam {
+    /// Dotted key, e.g. `proximity.decay_m`.
+    pub key: String,
+    /// The offending value.
+    pub value: f64,
+    /// Why it is invalid.
+    pub reason: &'static str,
+}
+
+impl InvalidParam {
+    /// `Ok` when `value` is finite and strictly positive, else an error for `prefix` + `name`.
+    pub fn positive_finite(prefix: &str, name: &str, value: f64) -> Result<(), InvalidParam> {
+        if value.is_finite() && value > 0.0 {
+            Ok(())
+        } else {
+            Err(InvalidParam {
+                key: format!("{prefix}{name}"),
+                value,
+                reason: "must be finite and > 0",
+            })
+        }
+    }
+
+    /// `Ok` when `value` is finite and in `[lo, hi]`, else an error for `prefix` + `name`.
+    pub fn in_range(
+        prefix: &str,
+        name: &str,
+        value: f64,
+        lo: f64,
+        hi: f64,
+        reason: &'static str,
+    ) -> Result<(), InvalidParam> {
+        if value.is_finite() && (lo..=hi).contains(&value) {
+            Ok(())
+        } else {
+            Err(InvalidParam {
+                key: format!("{prefix}{name}"),
+                value,
+                reason,
+            })
+        }
+    }
+}
+
+/// Errors loading a skin parameter file.
+#[derive(Debug, Error)]
+pub enum ParamsError {
+    /// Unreadable or unparsable file.
+    #[error(transparent)]
+    Yaml(#[from] YamlError),
+    /// A value out of its valid range.
+    #[error("{file}: {param}")]
+    Invalid {
+        /// The file.
+        file: String,
+        /// The parameter and why it is invalid.
+        param: InvalidParam,
+    },
+}
+
+/// All skin model parameters (one YAML file, sections as the fields).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SkinParams {
+    /// Proximity characteristic (distance <-> signal).
+    pub proximity: ProximityCharacteristic,
+    /// Force characteristic (force <-> signal).
+    pub force: ForceCharacteristic,
+    /// Fusion of force and proximity into the cells' virtual force (paper 003 eq. (6)).
+    pub fusion: FusionParams,
+    /// Repulsion from proximity (paper 000 eq. (3), paper 003 eq. (16)).
+    pub repulsion: RepulsionParams,
+}
+
+impl SkinParams {
+    /// Checks every section; the error's key is the dotted path in the file.
+    pub fn validate(&self) -> Result<(), InvalidParam> {
+        self.proximity.validate("proximity.")?;
+        self.force.validate("force.")?;
+        self.fusion.validate("fusion.")?;
+        self.repulsion.validate("repulsion.")?;
+        if self.repulsion.range_m > self.proximity.range_m {
+            return Err(InvalidParam {
+                key: "repulsion.range_m".into(),
+                value: self.repulsion.range_m,
+                reason: "must not exceed proximity.range_m (the cells measure no farther)",
+            });
+        }
+        Ok(())
+    }
+
+    /// Parses and validates YAML text; `source` names the file in errors.
+    pub fn from_yaml_str(text: &str, source: &str) -> Result<Self, ParamsError> {
+        let p: SkinParams = yaml::parse_str(text, source)?;
+        p.validate().map_err(|param| ParamsError::Invalid {
+            file: source.to_string(),
+            param,
+        })?;
+        Ok(p)
+    }
+
+    /// Reads, parses and validates the file at `path`.
+    pub fn load(path: &Path) -> Result<Self, ParamsError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| YamlError::Io {
+            file: file.clone(),
+            source,
+        })?;
+        Self::from_yaml_str(&text, &file)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    fn shipped() -> PathBuf {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../config/skin_model.yaml")
+    }
+
+    #[test]
+    fn shipped_params_load() {
+        let p = SkinParams::load(&shipped()).expect("shipped skin_model.yaml");
+        assert!(p.repulsion.range_m <= p.proximity.range_m);
+    }
+
+    #[test]
+    fn invalid_value_names_file_and_key() {
+        let text = std::fs::read_to_string(shipped()).unwrap();
+        let bad = text.replace("decay_m: 0.03", "decay_m: -0.03");
+        assert_ne!(
+            bad, text,
+            "test expects `decay_m: 0.03` in the shipped file"
+        );
+        let e = SkinParams::from_yaml_str(&bad, "bad.yaml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("bad.yaml") && e.contains("proximity.decay_m"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn parse_error_names_file_and_line() {
+        let text = "proximity:\n  range_m: 0.1\n  decay_m: 0.02\n  bogus: 3\n";
+        let e = SkinParams::from_yaml_str(text, "x.yaml").unwrap_err();
+        match &e {
+            ParamsError::Yaml(YamlError::Parse { file, line, .. }) => {
+                assert_eq!(file, "x.yaml");
+                assert!(line.is_some(), "{e}");
+            }
+            other => panic!("unexpected {other}"),
+        }
+        assert!(e.to_string().starts_with("x.yaml:"), "{e}");
+    }
+}

@@ -1,0 +1,367 @@
+//! The two inverses of the hierarchy, both in place in preallocated buffers:
+//!
+//! - `M⁻¹` of the SPD joint-space mass matrix: Cholesky `M = L Lᵀ`, then `M⁻¹ = L⁻ᵀ L⁻¹`
+//!   (our own in-place code: nalgebra's `Cholesky` takes and returns owned matrices, which
+//!   allocates for dynamic sizes). About n³ flops; n = 15 for TOMM.
+//! - the damped, rank-aware inverse `Λ̄ = (J̄ M⁻¹ J̄ᵀ)⁻¹` of paper 003 eq. (23): the matrix is
+//!   symmetric positive semidefinite, so it is decomposed by cyclic Jacobi rotations (accurate
+//!   small eigenvalues, allocation-free; nalgebra's `SymmetricEigen` allocates) and every
+//!   eigenvalue is inverted by the filter [`InverseParams::filter`].
+
+use super::HierarchyError;
+
+/// Parameters of the damped, rank-aware inverse of `A = J̄ M⁻¹ J̄ᵀ` (paper 003 eq. 23, 25).
+///
+/// Eigenvalues `e` of `A` are "task-space inverse masses" (1/kg for translational rows,
+/// 1/(kg m²) for rotational rows). With `e_max` the largest eigenvalue of the level:
+/// - `e ≤ max(rank_threshold_rel · e_max, rank_threshold_abs)`: the direction is not controllable
+///   (duplicated rows, a row dependent on a higher level, a vanished Jacobian): inverse 0, not
+///   counted in the rank;
+/// - `e ≥ damping`: exact inverse `1/e`, so the hierarchy is the paper's strict one;
+/// - in between (`x = e/damping < 1`): `x (3 − 2x) / damping`. The achieved fraction of the
+///   reference in that direction, `e · f(e) = x²(3 − 2x)`, is a smoothstep from 0 (singular) to
+///   1 (band edge) with zero slope at the edge, so torques fade smoothly when a direction is lost
+///   instead of growing like `1/√e` (the jerks and "extremely high speeds" near singularities).
+///
+/// Bounds that follow (documented in `docs/hierarchy.md`): `‖Λ̄‖ ≤ 1.125/damping`, and the level
+/// torque satisfies `‖τ̄‖ ≤ 1.03 √(λ_max(M)/damping) ‖r‖` for the reference `r` it is given.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InverseParams {
+    /// Eigenvalues below this fraction of the level's largest one are treated as zero
+    /// (dimensionless, in `[0, 1)`). Default `1e-12` (singular-value ratio 1e-6): well above
+    /// round-off (~1e-16), well below any direction the damping band still uses.
+    pub rank_threshold_rel: f64,
+    /// Eigenvalues below this are treated as zero (task-space inverse mass, ≥ 0). Default `1e-12`:
+    /// a Jacobian that vanishes (no active skin cell) contributes nothing.
+    pub rank_threshold_abs: f64,
+    /// Width of the damping band (task-space inverse mass, ≥ 0; 0 = plain thresholded
+    /// pseudo-inverse). Default `1e-3` (1/kg): damping starts when the effective task mass in a
+    /// direction exceeds 1000 kg, which on planar7 and TOMM happens only within a few degrees of
+    /// a singularity. Raise it to damp earlier (smaller torques, less tracking near singularities).
+    pub damping: f64,
+}
+
+impl Default for InverseParams {
+    fn default() -> Self {
+        Self { rank_threshold_rel: 1e-12, rank_threshold_abs: 1e-12, damping: 1e-3 }
+    }
+}
+
+impl InverseParams {
+    /// Checks ranges: `rank_threshold_rel ∈ [0, 1)`, `rank_threshold_abs ≥ 0`, `damping ≥ 0`,
+    /// all finite.
+    pub fn validate(&self) -> Result<(), HierarchyError> {
+        let check = |name, value: f64, ok: bool, reason| {
+            if value.is_finite() && ok {
+                Ok(())
+            } else {
+                Err(HierarchyError::InvalidParameter { name, value, reason })
+            }
+        };
+        check("rank_threshold_rel", self.rank_threshold_rel, (0.0..1.0).contains(&self.rank_threshold_rel), "must be in [0, 1)")?;
+        check("rank_threshold_abs", self.rank_threshold_abs, self.rank_threshold_abs >= 0.0, "must be finite and >= 0")?;
+        check("damping", self.damping, self.damping >= 0.0, "must be finite and >= 0")
+    }
+
+    /// Rank threshold for a level whose largest eigenvalue is `e_max`.
+    pub fn threshold(&self, e_max: f64) -> f64 {
+        (self.rank_threshold_rel * e_max).max(self.rank_threshold_abs)
+    }
+
+    /// Filtered inverse `f(e)` of one eigenvalue given the rank threshold `thr`
+    /// (see the type's documentation). Returns 0 for `e ≤ thr`.
+    pub fn filter(&self, e: f64, thr: f64) -> f64 {
+        if e <= thr {
+            0.0
+        } else if e >= self.damping {
+            1.0 / e
+        } else {
+            let x = e / self.damping;
+            x * (3.0 - 2.0 * x) / self.damping
+        }
+    }
+}
+
+/// Result of one damped inverse: how many directions were kept and how many were damped.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct InverseInfo {
+    pub(crate) rank: usize,
+    pub(crate) damped: usize,
+    pub(crate) min_kept: f64,
+}
+
+/// Cholesky `M = L Lᵀ` of the SPD `m` (n × n, column-major, lower triangle read) into `l`
+/// (lower triangle written, upper zeroed). Fails on a pivot that is not clearly positive.
+pub(crate) fn cholesky(m: &[f64], l: &mut [f64], n: usize) -> Result<(), HierarchyError> {
+    l[..n * n].fill(0.0);
+    // left-looking, column by column: L[j.., j] = M[j.., j] − Σ_{k<j} L[j, k] L[j.., k], so every
+    // inner loop runs down a contiguous column
+    for j in 0..n {
+        let (done, rest) = l.split_at_mut(j * n);
+        let col = &mut rest[j..n];
+        col.copy_from_slice(&m[j * n + j..(j + 1) * n]);
+        for k in 0..j {
+            let lk = &done[k * n..(k + 1) * n];
+            let ljk = lk[j];
+            if ljk != 0.0 {
+                for (c, x) in col.iter_mut().zip(&lk[j..n]) {
+                    *c -= ljk * x;
+                }
+            }
+        }
+        let d = col[0];
+        // relative guard: a pivot at round-off level means M is singular to working precision
+        // (NaN fails `>`, hence the explicit finiteness check)
+        if !d.is_finite() || d <= f64::EPSILON * m[j * n + j].abs() {
+            return Err(HierarchyError::NotPositiveDefinite { index: j, pivot: d });
+        }
+        let inv = 1.0 / d.sqrt();
+        for c in col.iter_mut() {
+            *c *= inv;
+        }
+    }
+    Ok(())
+}
+
+/// `M⁻¹ = L⁻ᵀ L⁻¹` from the Cholesky factor `l`; `linv` is scratch (n × n), `minv` the result
+/// (full symmetric matrix).
+pub(crate) fn spd_inverse_from_cholesky(l: &[f64], linv: &mut [f64], minv: &mut [f64], n: usize) {
+    // column j of L⁻¹: forward substitution L x = e_j, column-oriented
+    linv[..n * n].fill(0.0);
+    for j in 0..n {
+        let x = &mut linv[j * n..(j + 1) * n];
+        x[j] = 1.0;
+        for k in j..n {
+            let lk = &l[k * n..(k + 1) * n];
+            let xk = x[k] / lk[k];
+            x[k] = xk;
+            if xk != 0.0 {
+                for (xi, li) in x[k + 1..].iter_mut().zip(&lk[k + 1..]) {
+                    *xi -= xk * li;
+                }
+            }
+        }
+    }
+    // (L⁻ᵀ L⁻¹)_ij = Σ_{k ≥ max(i,j)} L⁻¹_ki L⁻¹_kj: a dot product of two column tails
+    for j in 0..n {
+        for i in 0..=j {
+            let s = super::dense::dot(&linv[i * n + j..(i + 1) * n], &linv[j * n + j..(j + 1) * n]);
+            minv[j * n + i] = s;
+            minv[i * n + j] = s;
+        }
+    }
+}
+
+/// Eigen decomposition of the symmetric `a` (m × m, overwritten; its diagonal ends up holding
+/// the eigenvalues) by cyclic Jacobi rotations; `v` receives the orthonormal eigenvectors as
+/// columns. Converges quadratically; 5–8 sweeps for m ≤ 6.
+pub(crate) fn symmetric_eigen(a: &mut [f64], v: &mut [f64], m: usize) {
+    v[..m * m].fill(0.0);
+    for i in 0..m {
+        v[i * m + i] = 1.0;
+    }
+    let total: f64 = a[..m * m].iter().map(|x| x * x).sum();
+    if total == 0.0 {
+        return;
+    }
+    const MAX_SWEEPS: usize = 50;
+    for _ in 0..MAX_SWEEPS {
+        let mut off = 0.0;
+        for q in 1..m {
+            for p in 0..q {
+                off += a[q * m + p] * a[q * m + p];
+            }
+        }
+        // off-diagonal mass below round-off of the whole matrix: diagonal to working precision
+        if off <= 1e-32 * total {
+            break;
+        }
+        for p in 0..m {
+            for q in p + 1..m {
+                let apq = a[q * m + p];
+                if apq == 0.0 {
+                    continue;
+                }
+                let (app, aqq) = (a[p * m + p], a[q * m + q]);
+                let theta = (aqq - app) / (2.0 * apq);
+                // smaller rotation angle (Numerical Recipes 11.1); 1/(2θ) avoids θ² overflow
+                let t = if theta.abs() > 1e150 {
+                    0.5 / theta
+                } else {
+                    theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt())
+                };
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let s = t * c;
+                // A ← A P (columns p, q), then A ← Pᵀ A (rows p, q), V ← V P
+                for k in 0..m {
+                    let (akp, akq) = (a[p * m + k], a[q * m + k]);
+                    a[p * m + k] = c * akp - s * akq;
+                    a[q * m + k] = s * akp + c * akq;
+                }
+                for k in 0..m {
+                    let (apk, aqk) = (a[k * m + p], a[k * m + q]);
+                    a[k * m + p] = c * apk - s * aqk;
+                    a[k * m + q] = s * apk + c * aqk;
+                }
+                a[q * m + p] = 0.0;
+                a[p * m + q] = 0.0;
+                for k in 0..m {
+                    let (vkp, vkq) = (v[p * m + k], v[q * m + k]);
+                    v[p * m + k] = c * vkp - s * vkq;
+                    v[q * m + k] = s * vkp + c * vkq;
+                }
+            }
+        }
+    }
+}
+
+/// Damped, rank-aware inverse of the symmetric PSD `a` (m × m, destroyed): `out = V f(E) Vᵀ`
+/// with the filter of [`InverseParams`]. `v` and `w` are scratch (m × m).
+///
+/// Fast path first: a Cholesky inverse `A⁻¹`; if `1/‖A⁻¹‖_F` (a lower bound of the smallest
+/// eigenvalue) is above both the damping band and the rank threshold, every eigenvalue gets
+/// `f(e) = 1/e`, so `A⁻¹` *is* the filtered inverse and the eigen decomposition (the most
+/// expensive step for m = 6) is skipped. Otherwise Jacobi and the filter.
+pub(crate) fn damped_inverse(
+    a: &mut [f64],
+    v: &mut [f64],
+    w: &mut [f64],
+    out: &mut [f64],
+    m: usize,
+    params: &InverseParams,
+) -> InverseInfo {
+    let trace: f64 = (0..m).map(|i| a[i * m + i]).sum();
+    if trace > 0.0 && cholesky(a, v, m).is_ok() {
+        spd_inverse_from_cholesky(v, w, out, m);
+        let e_min_bound = 1.0 / super::dense::norm(&out[..m * m]);
+        // e_max ≤ trace bounds the relative threshold from above
+        if e_min_bound >= params.damping && e_min_bound > params.threshold(trace) {
+            return InverseInfo { rank: m, damped: 0, min_kept: e_min_bound };
+        }
+    }
+    symmetric_eigen(a, v, m);
+    let e_max = (0..m).map(|i| a[i * m + i]).fold(0.0, f64::max);
+    let thr = params.threshold(e_max);
+    let mut info = InverseInfo { rank: 0, damped: 0, min_kept: 0.0 };
+    out[..m * m].fill(0.0);
+    for i in 0..m {
+        let e = a[i * m + i];
+        let f = params.filter(e, thr);
+        if f == 0.0 {
+            continue;
+        }
+        info.min_kept = if info.rank == 0 { e } else { info.min_kept.min(e) };
+        info.rank += 1;
+        if e < params.damping {
+            info.damped += 1;
+        }
+        let vi = &v[i * m..(i + 1) * m];
+        for c in 0..m {
+            let fc = f * vi[c];
+            for r in 0..m {
+                out[c * m + r] += vi[r] * fc;
+            }
+        }
+    }
+    info
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::DMatrix;
+
+    fn random_spd(n: usize, seed: u64) -> DMatrix<f64> {
+        let mut s = seed;
+        let b = DMatrix::from_fn(n, n, |_, _| {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        });
+        &b * b.transpose() + DMatrix::identity(n, n) * 0.1
+    }
+
+    #[test]
+    fn cholesky_inverse_matches_nalgebra() {
+        for n in [1, 2, 7, 15, 20] {
+            let m = random_spd(n, n as u64);
+            let (mut l, mut li, mut mi) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
+            cholesky(m.as_slice(), &mut l, n).unwrap();
+            spd_inverse_from_cholesky(&l, &mut li, &mut mi, n);
+            let mi = DMatrix::from_column_slice(n, n, &mi);
+            let err = (&m * &mi - DMatrix::identity(n, n)).norm();
+            assert!(err < 1e-10, "n = {n}: |M M⁻¹ − I| = {err}");
+        }
+    }
+
+    #[test]
+    fn cholesky_rejects_indefinite() {
+        let m = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        let mut l = vec![0.0; 4];
+        assert!(matches!(cholesky(m.as_slice(), &mut l, 2), Err(HierarchyError::NotPositiveDefinite { index: 1, .. })));
+    }
+
+    #[test]
+    fn jacobi_reconstructs_and_is_orthonormal() {
+        for m in [1, 2, 3, 6, 13] {
+            let a0 = random_spd(m, 100 + m as u64);
+            let mut a = a0.as_slice().to_vec();
+            let mut v = vec![0.0; m * m];
+            symmetric_eigen(&mut a, &mut v, m);
+            let vm = DMatrix::from_column_slice(m, m, &v);
+            let e = DMatrix::from_diagonal(&DMatrix::from_column_slice(m, m, &a).diagonal());
+            assert!((&vm * e * vm.transpose() - &a0).norm() < 1e-12 * a0.norm().max(1.0));
+            assert!((vm.transpose() * &vm - DMatrix::identity(m, m)).norm() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn damped_inverse_exact_above_band_and_bounded_below() {
+        let p = InverseParams::default();
+        p.validate().unwrap();
+        // well conditioned: exact inverse
+        let a0 = random_spd(4, 7);
+        let (mut a, mut v, mut w, mut out) = (a0.as_slice().to_vec(), vec![0.0; 16], vec![0.0; 16], vec![0.0; 16]);
+        let info = damped_inverse(&mut a, &mut v, &mut w, &mut out, 4, &p);
+        assert_eq!((info.rank, info.damped), (4, 0));
+        let inv = DMatrix::from_column_slice(4, 4, &out);
+        assert!((&a0 * inv - DMatrix::identity(4, 4)).norm() < 1e-10);
+        // rank one (duplicated rows): rank 1, bounded
+        let a0 = DMatrix::from_element(3, 3, 2.0);
+        let (mut a, mut v, mut w, mut out) = (a0.as_slice().to_vec(), vec![0.0; 9], vec![0.0; 9], vec![0.0; 9]);
+        let info = damped_inverse(&mut a, &mut v, &mut w, &mut out, 3, &p);
+        assert_eq!(info.rank, 1);
+        let inv = DMatrix::from_column_slice(3, 3, &out);
+        assert!((&a0 * &inv * &a0 - &a0).norm() < 1e-12, "pseudo-inverse property");
+        // the filter is continuous at the band edge and bounded by 1.125/damping
+        let d = p.damping;
+        assert!((p.filter(d * (1.0 - 1e-9), 0.0) - 1.0 / d).abs() < 1e-5 / d);
+        let max = (1..1000).map(|i| p.filter(d * i as f64 / 1000.0, 0.0)).fold(0.0, f64::max);
+        assert!(max <= 1.125 / d + 1e-9);
+    }
+
+    #[test]
+    fn fast_path_equals_filtered_eigen_inverse() {
+        let p = InverseParams::default();
+        for m in [1, 3, 6] {
+            let a0 = random_spd(m, 40 + m as u64);
+            let (mut a, mut v, mut w, mut fast) = (a0.as_slice().to_vec(), vec![0.0; m * m], vec![0.0; m * m], vec![0.0; m * m]);
+            damped_inverse(&mut a, &mut v, &mut w, &mut fast, m, &p);
+            // the eigen path on the same matrix
+            let mut a = a0.as_slice().to_vec();
+            symmetric_eigen(&mut a, &mut v, m);
+            let vm = DMatrix::from_column_slice(m, m, &v);
+            let thr = p.threshold(a0.norm());
+            let f = DMatrix::from_fn(m, m, |r, c| if r == c { p.filter(a[r * m + r], thr) } else { 0.0 });
+            let slow = &vm * f * vm.transpose();
+            assert!((DMatrix::from_column_slice(m, m, &fast) - &slow).norm() < 1e-10 * slow.norm());
+        }
+    }
+
+    #[test]
+    fn params_validation_names_the_key() {
+        let bad = InverseParams { damping: f64::NAN, ..Default::default() };
+        assert!(matches!(bad.validate(), Err(HierarchyError::InvalidParameter { name: "damping", .. })));
+        let bad = InverseParams { rank_threshold_rel: 1.0, ..Default::default() };
+        assert!(matches!(bad.validate(), Err(HierarchyError::InvalidParameter { name: "rank_threshold_rel", .. })));
+    }
+}

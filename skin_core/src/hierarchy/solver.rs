@@ -1,0 +1,394 @@
+//! The multi-priority torque solver of paper 003 eq. (19)-(25), with paper 000's force levels in
+//! the same pass.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::model::{bias_forces, crba, ModelData, RobotModel};
+
+use super::dense::{add_mul_vec, axpy, dot, mul, mul_tn, mul_tr_vec, mul_vec, norm, sub_mul_nt};
+use super::inverse::{cholesky, damped_inverse, spd_inverse_from_cholesky, InverseParams};
+use super::{HierarchyError, ReferenceKind, TaskLevel};
+
+/// What one level did in the last solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LevelDiagnostics {
+    /// Kind of the level's reference.
+    pub kind: ReferenceKind,
+    /// Active rows `m_k`.
+    pub rows: usize,
+    /// Rank used: eigenvalues of `J̄_k M⁻¹ J̄_kᵀ` above the rank threshold.
+    pub rank: usize,
+    /// Of these, directions inside the damping band (inverse faded: near a singularity or a
+    /// conflict with a higher level).
+    pub damped: usize,
+    /// Smallest eigenvalue kept (task-space inverse mass; 0 if rank 0). When every direction is
+    /// well above the damping band the eigen decomposition is skipped and this is the lower
+    /// bound `1/‖Λ̄‖_F` instead.
+    pub min_eigenvalue: f64,
+    /// `‖τ̄_k‖`, the projected torque of the level (N m).
+    pub torque_norm: f64,
+    /// Acceleration levels: `‖J_k q̈ + J̇_k q̇ − ẍ*_k‖` with the model-predicted
+    /// `q̈ = M⁻¹(Σ τ̄ + N_L τ_c*)` (what the bias term does not cancel is not included); `None`
+    /// for force levels.
+    pub task_error: Option<f64>,
+}
+
+impl LevelDiagnostics {
+    fn empty(kind: ReferenceKind) -> Self {
+        Self { kind, rows: 0, rank: 0, damped: 0, min_eigenvalue: 0.0, torque_norm: 0.0, task_error: None }
+    }
+}
+
+/// Preallocated workspace and parameters of the hierarchy; [`HierarchySolver::solve`] is the one
+/// function (mass matrix, ordered levels, posture torque, bias) → torque.
+///
+/// ```text
+/// τ* = Σ_k τ̄_k + N_L τ_c* + (C q̇ + g)                              paper 003 eq. (19)
+/// τ̄_k = J̄_kᵀ Λ̄_k (ẍ*_k − J̇_k q̇ − a_k)        acceleration level, eq. (20)
+/// τ̄_k = J̄_kᵀ F_k = N_{k−1} J_kᵀ F_k             force level (paper 000, augmented projection)
+/// a_k = J_k M⁻¹ Σ_{i<k} τ̄_i                                          eq. (21)
+/// J̄_k = J_k N_{k−1}ᵀ                                                 eq. (22)
+/// Λ̄_k = (J̄_k M⁻¹ J̄_kᵀ)⁻¹   damped, rank-aware (InverseParams)        eq. (23)
+/// N_k = N_{k−1} (I − J̄_kᵀ Λ̄_k J̄_k M⁻¹),  N_0 = I                   eq. (24), (25)
+/// ```
+/// After [`HierarchySolver::new`] no call allocates.
+#[derive(Clone, Debug)]
+pub struct HierarchySolver {
+    nv: usize,
+    max_levels: usize,
+    max_rows: usize,
+    params: InverseParams,
+    chol: Vec<f64>,
+    linv: Vec<f64>,
+    minv: DMatrix<f64>,
+    /// N_{k−1} during the pass, N_L after it.
+    nproj: DMatrix<f64>,
+    /// n × max_rows: J̄ᵀ, M⁻¹J̄ᵀ, N J̄ᵀ, M⁻¹J̄ᵀΛ̄.
+    jbt: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+    wt: Vec<f64>,
+    /// max_rows²: A, eigenvectors (or the Cholesky factor of A), scratch, Λ̄.
+    a: Vec<f64>,
+    v: Vec<f64>,
+    w: Vec<f64>,
+    lam: Vec<f64>,
+    /// max_rows: task-space residual and Λ̄ r.
+    r: Vec<f64>,
+    s: Vec<f64>,
+    /// n: Σ τ̄, τ̄_k, M⁻¹ Σ τ̄, N_L τ_c*, predicted q̈.
+    tau_sum: Vec<f64>,
+    tau_bar: Vec<f64>,
+    u_sum: Vec<f64>,
+    posture_proj: Vec<f64>,
+    qdd: DVector<f64>,
+    diagnostics: Vec<LevelDiagnostics>,
+    /// M and C q̇ + g for [`HierarchySolver::solve_model`].
+    m_model: DMatrix<f64>,
+    bias_model: DVector<f64>,
+}
+
+impl HierarchySolver {
+    /// Workspace for `nv` joints, at most `max_levels` levels of at most `max_rows` rows each.
+    pub fn new(nv: usize, max_levels: usize, max_rows: usize, params: InverseParams) -> Result<Self, HierarchyError> {
+        params.validate()?;
+        let (n, m) = (nv, max_rows);
+        Ok(Self {
+            nv,
+            max_levels,
+            max_rows,
+            params,
+            chol: vec![0.0; n * n],
+            linv: vec![0.0; n * n],
+            minv: DMatrix::zeros(n, n),
+            nproj: DMatrix::identity(n, n),
+            jbt: vec![0.0; n * m],
+            y: vec![0.0; n * m],
+            z: vec![0.0; n * m],
+            wt: vec![0.0; n * m],
+            a: vec![0.0; m * m],
+            v: vec![0.0; m * m],
+            w: vec![0.0; m * m],
+            lam: vec![0.0; m * m],
+            r: vec![0.0; m],
+            s: vec![0.0; m],
+            tau_sum: vec![0.0; n],
+            tau_bar: vec![0.0; n],
+            u_sum: vec![0.0; n],
+            posture_proj: vec![0.0; n],
+            qdd: DVector::zeros(n),
+            diagnostics: Vec::with_capacity(max_levels),
+            m_model: DMatrix::zeros(n, n),
+            bias_model: DVector::zeros(n),
+        })
+    }
+
+    /// Number of joints.
+    pub fn nv(&self) -> usize {
+        self.nv
+    }
+
+    /// Inverse parameters in use.
+    pub fn params(&self) -> &InverseParams {
+        &self.params
+    }
+
+    /// Replaces the inverse parameters (validated first; the old ones stay on error).
+    pub fn set_params(&mut self, params: InverseParams) -> Result<(), HierarchyError> {
+        params.validate()?;
+        self.params = params;
+        Ok(())
+    }
+
+    /// Per-level diagnostics of the last solve, in priority order (after an error: the levels
+    /// processed before it).
+    pub fn diagnostics(&self) -> &[LevelDiagnostics] {
+        &self.diagnostics
+    }
+
+    /// `M⁻¹` of the last successful solve.
+    pub fn mass_inverse(&self) -> &DMatrix<f64> {
+        &self.minv
+    }
+
+    /// The null-space projector `N_L` of the last successful solve (eq. 24 after the last level).
+    pub fn null_space(&self) -> &DMatrix<f64> {
+        &self.nproj
+    }
+
+    /// Model-predicted acceleration of the last successful solve, `M⁻¹ (Σ τ̄_k + N_L τ_c*)`, i.e. `q̈` when
+    /// the bias term exactly cancels `C q̇ + g`.
+    pub fn predicted_acceleration(&self) -> &DVector<f64> {
+        &self.qdd
+    }
+
+    /// Computes paper 003 eq. (19)-(25) into `tau_out`.
+    ///
+    /// - `mass_matrix`: `M(q)` (nv × nv, symmetric positive definite; the lower triangle is read),
+    ///   e.g. from `model::crba`. Factorized here every call.
+    /// - `levels`: the task levels, highest priority first (any iterator of `&TaskLevel` that can
+    ///   be cloned, e.g. `levels.iter()` or `order.iter().map(|&i| &levels[i])`, so an arrangement
+    ///   is just an order). Empty levels are skipped.
+    /// - `posture`: `τ_c*` of eq. (18), projected into the null space of all levels (`None`: 0).
+    /// - `bias`: `C q̇ + g` (e.g. `model::bias_forces`) added at the end; `None` leaves it out (the
+    ///   admittance resolver of paper 003 eq. (26) adds g itself).
+    ///
+    /// Inputs are checked first (sizes, finiteness); on error `tau_out` is untouched.
+    pub fn solve<'a, I>(
+        &mut self,
+        mass_matrix: &DMatrix<f64>,
+        levels: I,
+        posture: Option<&[f64]>,
+        bias: Option<&[f64]>,
+        tau_out: &mut DVector<f64>,
+    ) -> Result<(), HierarchyError>
+    where
+        I: IntoIterator<Item = &'a TaskLevel>,
+        I::IntoIter: Clone,
+    {
+        let n = self.nv;
+        self.check_inputs(mass_matrix, posture, bias, tau_out)?;
+        let levels = levels.into_iter();
+
+        cholesky(mass_matrix.as_slice(), &mut self.chol, n)?;
+        spd_inverse_from_cholesky(&self.chol, &mut self.linv, self.minv.as_mut_slice(), n);
+        self.nproj.fill_with_identity();
+        self.tau_sum.fill(0.0);
+        self.u_sum.fill(0.0);
+        self.diagnostics.clear();
+        let mut first = true; // N_{k−1} = I: skip the products with it
+
+        for (k, level) in levels.clone().enumerate() {
+            self.check_level(k, level)?;
+            let m = level.rows();
+            let mut diag = LevelDiagnostics::empty(level.kind());
+            if m == 0 {
+                self.diagnostics.push(diag);
+                continue;
+            }
+            let (nm, mm) = (n * m, m * m);
+            let jt = level.jt_slice();
+            let minv = self.minv.as_slice();
+            // J̄_kᵀ = N_{k−1} J_kᵀ (eq. 22)
+            if first {
+                self.jbt[..nm].copy_from_slice(jt);
+            } else {
+                mul(self.nproj.as_slice(), jt, &mut self.jbt[..nm], n, n, m);
+            }
+            // Y = M⁻¹ J̄ᵀ, A = J̄ M⁻¹ J̄ᵀ (symmetrized against round-off), Λ̄ (eq. 23)
+            mul(minv, &self.jbt[..nm], &mut self.y[..nm], n, n, m);
+            mul_tn(&self.jbt[..nm], &self.y[..nm], &mut self.a[..mm], n, m, m);
+            for c in 0..m {
+                for r in 0..c {
+                    let s = 0.5 * (self.a[c * m + r] + self.a[r * m + c]);
+                    self.a[c * m + r] = s;
+                    self.a[r * m + c] = s;
+                }
+            }
+            let info = damped_inverse(&mut self.a[..mm], &mut self.v[..mm], &mut self.w[..mm], &mut self.lam[..mm], m, &self.params);
+            diag.rows = m;
+            diag.rank = info.rank;
+            diag.damped = info.damped;
+            diag.min_eigenvalue = info.min_kept;
+
+            // the level's task-space command: Λ̄ (ẍ* − J̇q̇ − a_k) or F
+            match level.kind() {
+                ReferenceKind::Acceleration => {
+                    // a_k = J_k M⁻¹ Σ_{i<k} τ̄_i (eq. 21), M⁻¹ Σ τ̄ kept up to date below
+                    mul_tr_vec(jt, &self.u_sum, &mut self.r[..m], n, m);
+                    for ((ri, x), d) in self.r[..m].iter_mut().zip(level.target()).zip(level.jdot_qdot()) {
+                        *ri = x - d - *ri;
+                    }
+                    mul_vec(&self.lam[..mm], &self.r[..m], &mut self.s[..m], m, m);
+                }
+                ReferenceKind::Force => self.s[..m].copy_from_slice(level.target()),
+            }
+            // τ̄_k = J̄_kᵀ s (eq. 20); M⁻¹ τ̄_k = Y s
+            mul_vec(&self.jbt[..nm], &self.s[..m], &mut self.tau_bar, n, m);
+            axpy(1.0, &self.tau_bar, &mut self.tau_sum);
+            add_mul_vec(&self.y[..nm], &self.s[..m], &mut self.u_sum, n, m);
+            diag.torque_norm = norm(&self.tau_bar);
+            if !self.tau_sum.iter().all(|t| t.is_finite()) {
+                return Err(HierarchyError::Overflow { level: k });
+            }
+
+            // N_k = N_{k−1} − (N_{k−1} J̄ᵀ)(M⁻¹ J̄ᵀ Λ̄)ᵀ (eq. 24 with (J̄^{#M})ᵀ = Λ̄ J̄ M⁻¹, eq. 25)
+            if info.rank > 0 {
+                mul(&self.y[..nm], &self.lam[..mm], &mut self.wt[..nm], n, m, m);
+                if first {
+                    self.z[..nm].copy_from_slice(&self.jbt[..nm]);
+                } else {
+                    mul(self.nproj.as_slice(), &self.jbt[..nm], &mut self.z[..nm], n, n, m);
+                }
+                sub_mul_nt(self.nproj.as_mut_slice(), &self.z[..nm], &self.wt[..nm], n, m, n);
+                first = false;
+            }
+            self.diagnostics.push(diag);
+        }
+
+        // N_L τ_c* (eq. 19) and the predicted acceleration
+        let nlevels = self.diagnostics.len();
+        if let Some(tc) = posture {
+            mul_vec(self.nproj.as_slice(), tc, &mut self.posture_proj, n, n);
+            axpy(1.0, &self.posture_proj, &mut self.tau_sum);
+            add_mul_vec(self.minv.as_slice(), &self.posture_proj, &mut self.u_sum, n, n);
+        }
+        self.qdd.as_mut_slice().copy_from_slice(&self.u_sum);
+        for (k, level) in levels.enumerate() {
+            if level.kind() == ReferenceKind::Acceleration && level.rows() > 0 {
+                let mut e2 = 0.0;
+                for r in 0..level.rows() {
+                    let e = dot(level.jacobian_row(r), &self.u_sum) + level.jdot_qdot()[r] - level.target()[r];
+                    e2 += e * e;
+                }
+                self.diagnostics[k].task_error = Some(e2.sqrt());
+            }
+        }
+        if let Some(b) = bias {
+            axpy(1.0, b, &mut self.tau_sum);
+        }
+        if !self.tau_sum.iter().all(|t| t.is_finite()) {
+            return Err(HierarchyError::Overflow { level: nlevels });
+        }
+        tau_out.as_mut_slice().copy_from_slice(&self.tau_sum);
+        Ok(())
+    }
+
+    /// [`HierarchySolver::solve`] with `M` and `C q̇ + g` computed from the model at the state of
+    /// the last `model::update_kinematics` on `data` (CRBA and RNEA into the solver's own
+    /// buffers); `include_bias = false` leaves the bias out.
+    pub fn solve_model<'a, I>(
+        &mut self,
+        model: &RobotModel,
+        data: &mut ModelData,
+        levels: I,
+        posture: Option<&[f64]>,
+        include_bias: bool,
+        tau_out: &mut DVector<f64>,
+    ) -> Result<(), HierarchyError>
+    where
+        I: IntoIterator<Item = &'a TaskLevel>,
+        I::IntoIter: Clone,
+    {
+        // moved out for the call (self.solve borrows self mutably); empty matrices do not allocate
+        let mut m = std::mem::replace(&mut self.m_model, DMatrix::zeros(0, 0));
+        let mut bias = std::mem::replace(&mut self.bias_model, DVector::zeros(0));
+        let run = || -> Result<(), HierarchyError> {
+            let model_error = |e: crate::model::ModelError| HierarchyError::Model { message: e.to_string() };
+            crba(model, data, &mut m).map_err(model_error)?;
+            if include_bias {
+                bias_forces(model, data, &mut bias).map_err(model_error)?;
+            }
+            self.solve(&m, levels, posture, include_bias.then_some(bias.as_slice()), tau_out)
+        };
+        let result = run();
+        self.m_model = m;
+        self.bias_model = bias;
+        result
+    }
+
+    fn check_inputs(
+        &self,
+        mass_matrix: &DMatrix<f64>,
+        posture: Option<&[f64]>,
+        bias: Option<&[f64]>,
+        tau_out: &DVector<f64>,
+    ) -> Result<(), HierarchyError> {
+        let n = self.nv;
+        let dim = |what, got: usize| if got == n { Ok(()) } else { Err(HierarchyError::Dimension { what, expected: n, got }) };
+        dim("mass matrix rows", mass_matrix.nrows())?;
+        dim("mass matrix columns", mass_matrix.ncols())?;
+        dim("torque output", tau_out.len())?;
+        for c in 0..n {
+            for r in 0..n {
+                let value = mass_matrix[(r, c)];
+                if !value.is_finite() {
+                    return Err(HierarchyError::NonFiniteMassMatrix { row: r, col: c, value });
+                }
+            }
+        }
+        for (what, v) in [("posture torque", posture), ("bias", bias)] {
+            if let Some(v) = v {
+                dim(what, v.len())?;
+                if let Some((index, &value)) = v.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+                    return Err(HierarchyError::NonFinite { what, index, value });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn check_level(&self, k: usize, level: &TaskLevel) -> Result<(), HierarchyError> {
+        if k >= self.max_levels {
+            return Err(HierarchyError::Capacity { what: "levels".to_string(), got: k + 1, capacity: self.max_levels });
+        }
+        if level.nv() != self.nv {
+            return Err(HierarchyError::LevelColumns { level: k, name: level.name().to_string(), expected: self.nv, got: level.nv() });
+        }
+        if level.rows() > self.max_rows {
+            return Err(HierarchyError::Capacity {
+                what: format!("rows of level {k} (`{}`)", level.name()),
+                got: level.rows(),
+                capacity: self.max_rows,
+            });
+        }
+        let bad = |what, index: usize, value: f64| HierarchyError::NonFiniteLevel { level: k, name: level.name().to_string(), what, index, value };
+        if let Some((i, &v)) = level.jt_slice().iter().enumerate().find(|(_, x)| !x.is_finite()) {
+            // storage is Jᵀ column-major, so i = row · nv + column of J
+            return Err(bad("jacobian", i, v));
+        }
+        let (target_name, drift) = match level.kind() {
+            ReferenceKind::Acceleration => ("xdd_star", true),
+            ReferenceKind::Force => ("force", false),
+        };
+        if let Some((i, &v)) = level.target().iter().enumerate().find(|(_, x)| !x.is_finite()) {
+            return Err(bad(target_name, i, v));
+        }
+        if drift {
+            if let Some((i, &v)) = level.jdot_qdot().iter().enumerate().find(|(_, x)| !x.is_finite()) {
+                return Err(bad("jdot_qdot", i, v));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,209 @@
+//! The control loop runs at kHz rates: after setup, kinematics and dynamics, the skin's per-cycle
+//! functions and the hierarchy must not touch the heap. A counting global allocator checks that
+//! (one test binary, since a binary has one global allocator).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::path::PathBuf;
+
+use nalgebra::{DMatrix, DVector, Matrix6xX, Vector3, Vector6};
+use skin_core::hierarchy::*;
+use skin_core::model::*;
+use skin_core::skin::aggregate::{aggregate_patches, PatchWrench};
+use skin_core::skin::cell_forces::{cell_contact_forces, cell_repulsion_forces, PointForce};
+use skin_core::skin::layout::SkinLayout;
+use skin_core::skin::params::SkinParams;
+use skin_core::skin::signals::CellReading;
+use skin_core::skin::torques::{patch_wrenches_to_torques, point_forces_to_torques};
+use skin_core::skin::transforms::{patch_poses_world, patch_wrench_world, sum_patch_forces_in_frame};
+
+struct Counting;
+
+thread_local! {
+    // Per thread, so that the test harness's own threads do not count.
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn count() {
+    let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        count();
+        System.alloc(layout)
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        System.dealloc(ptr, layout)
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        count();
+        System.realloc(ptr, layout, new_size)
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn dynamics_do_not_allocate_after_setup() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../urdf/tomm.urdf");
+    let model = RobotModel::from_urdf_file(std::path::Path::new(path)).unwrap();
+    let n = model.nv();
+    let mut data = ModelData::new(&model);
+    let mut m = DMatrix::zeros(n, n);
+    let mut tau = DVector::zeros(n);
+    let mut j = Matrix6xX::zeros(n);
+    let mut jd = Vector6::zeros();
+    let frames: Vec<usize> = (0..n).map(|b| model.joint_child_frame(b)).collect();
+    let q: Vec<f64> = (0..n).map(|i| 0.1 * i as f64 - 0.5).collect();
+    let qd: Vec<f64> = (0..n).map(|i| 0.3 - 0.05 * i as f64).collect();
+    let qdd = vec![0.7; n];
+    let p = Vector3::new(0.01, 0.02, 0.03);
+
+    let mut step = |data: &mut ModelData| {
+        update_kinematics(&model, data, &q, &qd).unwrap();
+        for &f in &frames {
+            point_jacobian(&model, data, f, &p, &mut j).unwrap();
+            point_jacobian_dot_qdot(&model, data, f, &p, &mut jd).unwrap();
+        }
+        crba(&model, data, &mut m).unwrap();
+        rnea(&model, data, &qdd, &mut tau).unwrap();
+        bias_forces(&model, data, &mut tau).unwrap();
+        gravity(&model, data, &mut tau).unwrap();
+        let _ = frame_pose(data, frames[3]);
+    };
+    step(&mut data); // warm-up
+    // the counter does see heap allocations
+    let probe = allocations();
+    std::hint::black_box(vec![1u8; 16]);
+    assert!(allocations() > probe);
+    let before = allocations();
+    for _ in 0..10 {
+        step(&mut data);
+    }
+    let after = allocations();
+    assert_eq!(after - before, 0, "{} heap allocations in the dynamics loop", after - before);
+}
+
+#[test]
+fn skin_cycle_does_not_allocate_after_setup() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let model = RobotModel::from_urdf_file(&root.join("urdf/tomm.urdf")).unwrap();
+    let layout = SkinLayout::load(&root.join("config/skin/tomm.yaml"))
+        .unwrap()
+        .resolve(&model)
+        .unwrap();
+    let params = SkinParams::load(&root.join("config/skin_model.yaml")).unwrap();
+    let n = layout.num_cells();
+    let mut data = ModelData::new(&model);
+    let q: Vec<f64> = (0..model.nv()).map(|i| 0.2 * i as f64 - 0.4).collect();
+    let qd = vec![0.0; model.nv()];
+    let readings: Vec<CellReading> = (0..n)
+        .map(|i| CellReading::uniform((i % 7) as f64 / 7.0, (i % 5) as f64 / 5.0))
+        .collect();
+    let hand = model.frame_index("right_hand").unwrap();
+
+    // Setup: buffers reserved once.
+    let mut wrenches: Vec<PatchWrench> = Vec::with_capacity(layout.patches().len());
+    let mut poses = Vec::with_capacity(layout.patches().len());
+    let mut forces: Vec<PointForce> = Vec::with_capacity(n);
+    let mut tau = DVector::zeros(model.nv());
+
+    let mut cycle = |data: &mut ModelData| {
+        update_kinematics(&model, data, &q, &qd).unwrap();
+        aggregate_patches(&layout, &readings, &params.fusion, &mut wrenches).unwrap();
+        patch_poses_world(&layout, |f| data.frame_pose(f), &mut poses);
+        let h = sum_patch_forces_in_frame(data.frame_pose(hand), &poses, &wrenches, |j| j < 6);
+        let w = patch_wrench_world(&poses[0], &wrenches[0]);
+        patch_wrenches_to_torques(&model, data, &layout, &wrenches, |_| true, &mut tau);
+        cell_repulsion_forces(
+            &layout,
+            &readings,
+            &params.proximity,
+            &params.repulsion,
+            |f| data.frame_pose(f),
+            &mut forces,
+        )
+        .unwrap();
+        point_forces_to_torques(&model, data, &forces, &mut tau);
+        cell_contact_forces(
+            &layout,
+            &readings,
+            &params.force,
+            &params.fusion,
+            |f| data.frame_pose(f),
+            &mut forces,
+        )
+        .unwrap();
+        point_forces_to_torques(&model, data, &forces, &mut tau);
+        std::hint::black_box((h, w, &tau));
+    };
+    cycle(&mut data); // first call may size the output vectors
+    let before = allocations();
+    for _ in 0..10 {
+        cycle(&mut data);
+    }
+    assert_eq!(allocations() - before, 0, "skin cycle allocated");
+    assert!(!forces.is_empty());
+}
+
+#[test]
+fn hierarchy_does_not_allocate_after_setup() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../urdf/tomm.urdf");
+    let model = RobotModel::from_urdf_file(std::path::Path::new(path)).unwrap();
+    let n = model.nv();
+    let mut data = ModelData::new(&model);
+    let mut m = DMatrix::zeros(n, n);
+    let mut bias = DVector::zeros(n);
+    let mut j = Matrix6xX::zeros(n);
+    let mut jd = Vector6::zeros();
+    let hand = model.frame_index("right_hand").unwrap();
+    let forearm = model.frame_index("right_forearm_link").unwrap();
+    let left = model.frame_index("left_hand").unwrap();
+    let mut levels: Vec<TaskLevel> = [("cells", 8), ("wrist", 3), ("hand", 3), ("left", 6)].iter().map(|&(name, rows)| TaskLevel::new(name, n, rows)).collect();
+    let mut solver = HierarchySolver::new(n, 4, 8, InverseParams::default()).unwrap();
+    let mut tau = DVector::zeros(n);
+    let posture = vec![0.3; n];
+    let q: Vec<f64> = (0..n).map(|i| 0.1 * i as f64 - 0.5).collect();
+    let qd: Vec<f64> = (0..n).map(|i| 0.3 - 0.05 * i as f64).collect();
+    let p0 = Vector3::zeros();
+    let order = [0usize, 1, 2, 3];
+
+    let mut cycle = |active_cells: usize| {
+        update_kinematics(&model, &mut data, &q, &qd).unwrap();
+        crba(&model, &mut data, &mut m).unwrap();
+        bias_forces(&model, &mut data, &mut bias).unwrap();
+        levels[0].clear();
+        for c in 0..active_cells {
+            let cell = Vector3::new(-0.05 * c as f64, 0.0, 0.05);
+            point_jacobian(&model, &data, forearm, &cell, &mut j).unwrap();
+            levels[0].push_directional(&[0.0, 0.6, 0.8], &j.fixed_rows::<3>(0), Reference::Force { f: &[2.0] }).unwrap();
+        }
+        point_jacobian(&model, &data, hand, &p0, &mut j).unwrap();
+        point_jacobian_dot_qdot(&model, &data, hand, &p0, &mut jd).unwrap();
+        let (ang, lin) = ([jd[3], jd[4], jd[5]], [jd[0], jd[1], jd[2]]);
+        levels[1].set(&j.fixed_rows::<3>(3), Reference::Acceleration { xdd_star: &[0.1, 0.0, 0.0], jdot_qdot: &ang }).unwrap();
+        levels[2].set(&j.fixed_rows::<3>(0), Reference::Acceleration { xdd_star: &[0.0, 0.2, 0.0], jdot_qdot: &lin }).unwrap();
+        point_jacobian(&model, &data, left, &p0, &mut j).unwrap();
+        point_jacobian_dot_qdot(&model, &data, left, &p0, &mut jd).unwrap();
+        levels[3].set(&j, Reference::Acceleration { xdd_star: &[0.0; 6], jdot_qdot: jd.as_slice() }).unwrap();
+        solver.solve(&m, order.iter().map(|&i| &levels[i]), Some(&posture), Some(bias.as_slice()), &mut tau).unwrap();
+        assert!(solver.diagnostics().len() == 4);
+        solver.solve_model(&model, &mut data, &levels, Some(&posture), true, &mut tau).unwrap();
+    };
+    cycle(3); // warm-up
+    let probe = allocations();
+    std::hint::black_box(vec![1u8; 16]);
+    assert!(allocations() > probe, "the counter sees heap allocations");
+    let before = allocations();
+    for k in 0..10 {
+        cycle(k % 9); // 0..8 active cells, including an empty level
+    }
+    let after = allocations();
+    assert_eq!(after - before, 0, "{} heap allocations in the hierarchy loop", after - before);
+}

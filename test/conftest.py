@@ -61,9 +61,10 @@ def rclpy_node(request):
     rclpy.shutdown(context=ctx)
 
 
-def spin_until(node, predicate, timeout_s: float, what: str):
-    """Spin `node` until `predicate()` holds; fail naming `what` after `timeout_s` (a bound on a
-    wait for an event, not a timing assertion)."""
+def spin_until(node, predicate, timeout_s: float, what):
+    """Spin `node` until `predicate()` holds; fail naming `what` (a string, or a function giving
+    one at the time of failure) after `timeout_s` (a bound on a wait for an event, not a timing
+    assertion)."""
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
 
@@ -73,7 +74,8 @@ def spin_until(node, predicate, timeout_s: float, what: str):
     try:
         while not predicate():
             if time.monotonic() > deadline:
-                pytest.fail(f"timed out after {timeout_s} s waiting for {what}")
+                pytest.fail(f"timed out after {timeout_s} s waiting for "
+                            f"{what() if callable(what) else what}")
             ex.spin_once(timeout_sec=0.05)
     finally:
         ex.remove_node(node)

@@ -64,7 +64,7 @@ def test_skin_cells_roundtrip_rclpy_r2r(spawn, rclpy_node):
     for m in sent:
         pub.publish(m)
     spin_until(rclpy_node, lambda: len(received) >= N_MSGS, 30.0,
-               f"{N_MSGS} relayed messages (got {len(received)})")
+               lambda: f"{N_MSGS} relayed messages (got {len(received)})")
     for s, g in zip(sent, received):
         assert_same(s, g)
     assert relay.wait(timeout=10) == 0, relay.stdout.read()

@@ -1,6 +1,7 @@
 //! Relays `skin_msgs/SkinCellArray` from one topic to another through r2r's Rust types: the
 //! smallest r2r node of the project, used by the interoperability test (rclpy publishes, this
-//! node decodes and re-encodes every field, rclpy checks what comes back).
+//! node decodes and re-encodes every field, rclpy checks what comes back). It starts relaying
+//! once its output has a subscriber, so nothing is lost to discovery.
 //!
 //! `skin_cells_relay --input /skin/cells_in --output /skin/cells_out [--count N]`
 use anyhow::Result;
@@ -33,7 +34,15 @@ fn main() -> Result<()> {
     let mut pool = LocalPool::new();
     let counter = relayed.clone();
     let output = args.output.clone();
+    let matched = publisher.wait_for_inter_process_subscribers()?;
     pool.spawner().spawn_local(async move {
+        // Discovery is not symmetric: a peer may already see our publisher while our writer has
+        // not matched its reader yet, and a volatile writer drops what it sends before that. The
+        // input waits meanwhile in the reader's history (depth 10).
+        if let Err(e) = matched.await {
+            eprintln!("skin_cells_relay: waiting for a subscriber on {output} failed: {e}");
+            return;
+        }
         while let Some(msg) = sub.next().await {
             if let Err(e) = publisher.publish(&msg) {
                 eprintln!("skin_cells_relay: publish on {output} failed: {e}");

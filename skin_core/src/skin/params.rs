@@ -117,11 +117,7 @@ impl SkinParams {
 
     /// Reads, parses and validates the file at `path`.
     pub fn load(path: &Path) -> Result<Self, ParamsError> {
-        let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| YamlError::Io {
-            file: file.clone(),
-            source,
-        })?;
+        let (text, file) = yaml::read_text(path)?;
         Self::from_yaml_str(&text, &file)
     }
 }

@@ -64,6 +64,15 @@ impl YamlError {
     }
 }
 
+/// Reads the file at `path`; returns its text and its name as errors should show it.
+pub fn read_text(path: &Path) -> Result<(String, String), YamlError> {
+    let file = path.display().to_string();
+    match std::fs::read_to_string(path) {
+        Ok(text) => Ok((text, file)),
+        Err(source) => Err(YamlError::Io { file, source }),
+    }
+}
+
 /// Parses `text` as `T`; `source` names the file in errors.
 pub fn parse_str<T: DeserializeOwned>(text: &str, source: &str) -> Result<T, YamlError> {
     serde_saphyr::from_str::<T>(text).map_err(|e| {
@@ -80,14 +89,4 @@ pub fn parse_str<T: DeserializeOwned>(text: &str, source: &str) -> Result<T, Yam
             message,
         }
     })
-}
-
-/// Reads and parses the file at `path` as `T`.
-pub fn read_file<T: DeserializeOwned>(path: &Path) -> Result<T, YamlError> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| YamlError::Io {
-        file: file.clone(),
-        source,
-    })?;
-    parse_str(&text, &file)
 }

@@ -1,0 +1,479 @@
+//! The resolver itself: paper 003 eq. (26) integrated exactly per step, the inner velocity loop,
+//! the limits and the safe stop, for the arms and the base at their own rates.
+
+use super::error::ResolverError;
+use super::limits::{clamp_norm, finite_or_max, position_limit, rate_limit, scale_chains};
+use super::params::ResolverParams;
+use crate::model::RobotModel;
+
+/// Names of the holonomic base's joints in the model: world-frame x, y (prismatic) and yaw.
+/// A model has all three (a mobile robot) or none (a fixed arm).
+pub const BASE_JOINTS: [&str; 3] = ["base_x_joint", "base_y_joint", "base_yaw_joint"];
+
+/// A late cycle integrates over at most this many nominal periods (no large velocity step).
+const MAX_DT_PERIODS: f64 = 2.0;
+
+/// The velocity commands of the last step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Commands {
+    /// Arm joint velocities \[rad/s or m/s\], in model order of the arm joints
+    /// ([`Resolver::arm_joints`]).
+    pub joint_velocities: Vec<f64>,
+    /// Base twist `(vx [m/s], vy [m/s], wz [rad/s])` in the BASE frame (a `geometry_msgs/Twist`'s
+    /// linear.x, linear.y, angular.z); zero for a model without base.
+    pub base_twist: [f64; 3],
+}
+
+/// Exact zero-order-hold step of `m v̇ + c v = f`: `v' = e v + phi f`.
+#[derive(Clone, Copy, Debug, Default)]
+struct Step {
+    e: f64,
+    phi: f64,
+}
+
+impl Step {
+    fn new(m: f64, c: f64, dt: f64) -> Self {
+        let x = c * dt / m;
+        let e = (-x).exp();
+        // (1 - e)/c, written so that it tends to dt/m without cancellation as c -> 0
+        let phi = if x > 1e-8 {
+            -(-x).exp_m1() / c
+        } else {
+            dt / m * (1.0 - 0.5 * x)
+        };
+        Self { e, phi }
+    }
+}
+
+/// Per-arm-joint constants, from the model and the parameters.
+#[derive(Clone, Debug, Default)]
+struct ArmJoint {
+    index: usize,
+    inertia: f64,
+    damping: f64,
+    amax: f64,
+    lower: f64,
+    upper: f64,
+}
+
+/// The admittance torque resolver of paper 003 eq. (26):
+///
+/// ```text
+/// M_a q̈_a + C_a q̇_a + g = τ_a*        (arm joints)
+/// M_b ẍ_b + D_b ẋ_b     = τ_b*        (base: x, y, yaw, inertia and damping in the base frame)
+/// ```
+///
+/// The virtual velocities are integrated exactly over each step (zero-order hold), pulled
+/// towards the measured velocities by the inner loop, limited (velocity, position, acceleration)
+/// and sent as the commands; the limited command is the new virtual state (no wind-up).
+///
+/// Arms and base run independently: call [`Resolver::update_arms`] at the arm rate (TOMM: 125 Hz)
+/// and [`Resolver::update_base`] at the base rate (1 kHz), each with its own `dt`, from the same
+/// or different threads' data; [`Resolver::update`] does both with one `dt`. Start from the robot's
+/// state with [`Resolver::reset`]. All buffers are allocated by [`Resolver::new`].
+#[derive(Clone, Debug)]
+pub struct Resolver {
+    params: ResolverParams,
+    nv: usize,
+    arm: Vec<ArmJoint>,
+    arm_indices: Vec<usize>,
+    /// Chain (arm) of each arm joint, for the direction-keeping velocity scaling.
+    chain: Vec<usize>,
+    chain_scale: Vec<f64>,
+    /// Commanded velocity limit of each arm joint.
+    vmax: Vec<f64>,
+    /// Scratch: the virtual velocities before the limits.
+    target: Vec<f64>,
+    /// Cached exact-step coefficients for `arm_dt`.
+    arm_steps: Vec<Step>,
+    arm_dt: f64,
+    base: Option<[usize; 3]>,
+    base_steps: [Step; 3],
+    base_dt: f64,
+    /// Base virtual velocity = last command, WORLD frame (x, y, yaw rate).
+    base_world: [f64; 3],
+    commands: Commands,
+}
+
+impl Resolver {
+    /// Builds the resolver for `model`: base joints by name ([`BASE_JOINTS`]), every other moving
+    /// joint is an arm joint; velocity and position limits come from the URDF.
+    pub fn new(model: &RobotModel, params: ResolverParams) -> Result<Self, ResolverError> {
+        let found: Vec<Option<usize>> = BASE_JOINTS.iter().map(|n| model.joint_index(n)).collect();
+        let base = match found.as_slice() {
+            [Some(x), Some(y), Some(yaw)] => Some([*x, *y, *yaw]),
+            [None, None, None] => None,
+            _ => {
+                return Err(ResolverError::Model(format!(
+                    "a mobile base needs all of {BASE_JOINTS:?}, the model has only some of them"
+                )))
+            }
+        };
+        let is_base = |j: usize| base.is_some_and(|b| b.contains(&j));
+        let arm_indices: Vec<usize> = (0..model.nv()).filter(|&j| !is_base(j)).collect();
+        // A chain (one arm) = the arm joints below one root arm joint (attached to the world or
+        // to the base).
+        let root = |mut j: usize| {
+            while let Some(p) = model.joint_parent(j).filter(|&p| !is_base(p)) {
+                j = p;
+            }
+            j
+        };
+        let mut roots: Vec<usize> = Vec::new();
+        let mut chain = Vec::with_capacity(arm_indices.len());
+        for &j in &arm_indices {
+            let r = root(j);
+            chain.push(roots.iter().position(|&x| x == r).unwrap_or_else(|| {
+                roots.push(r);
+                roots.len() - 1
+            }));
+        }
+        let na = arm_indices.len();
+        let arm = arm_indices
+            .iter()
+            .map(|&index| ArmJoint {
+                index,
+                ..Default::default()
+            })
+            .collect();
+        let mut r = Self {
+            params: params.clone(),
+            nv: model.nv(),
+            arm_steps: vec![Step::default(); na],
+            arm,
+            chain,
+            chain_scale: vec![1.0; roots.len()],
+            vmax: vec![0.0; na],
+            target: vec![0.0; na],
+            arm_dt: f64::NAN,
+            base,
+            base_steps: [Step::default(); 3],
+            base_dt: f64::NAN,
+            base_world: [0.0; 3],
+            commands: Commands {
+                joint_velocities: vec![0.0; na],
+                base_twist: [0.0; 3],
+            },
+            arm_indices,
+        };
+        r.set_params(model, params)?;
+        Ok(r)
+    }
+
+    /// Replaces the parameters (validated first; on error nothing changes). The virtual
+    /// velocities and the last command are kept, so a gain change causes no velocity jump.
+    pub fn set_params(
+        &mut self,
+        model: &RobotModel,
+        params: ResolverParams,
+    ) -> Result<(), ResolverError> {
+        params.validate()?;
+        for name in params.arm.joints.keys() {
+            let ok = model
+                .joint_index(name)
+                .is_some_and(|j| self.arm_indices.contains(&j));
+            if !ok {
+                return Err(ResolverError::UnknownJoint {
+                    key: format!("arm.joints.{name}"),
+                    joint: name.clone(),
+                });
+            }
+        }
+        let limits = model.joint_limits();
+        let mut joints = self.arm.clone();
+        let mut vmax = self.vmax.clone();
+        for (a, vmax) in joints.iter_mut().zip(&mut vmax) {
+            let name = &model.joint_names()[a.index];
+            let lim = &limits[a.index];
+            if !(lim.velocity.is_finite() && lim.velocity > 0.0)
+                || lim.lower.is_nan()
+                || lim.upper.is_nan()
+            {
+                return Err(ResolverError::Model(format!(
+                    "joint `{name}`: URDF velocity limit {} (must be finite and > 0) or position limits [{}, {}]",
+                    lim.velocity, lim.lower, lim.upper
+                )));
+            }
+            let o = params.arm.joints.get(name).copied().unwrap_or_default();
+            a.inertia = o.inertia.unwrap_or(params.arm.inertia);
+            a.damping = o.damping.unwrap_or(params.arm.damping);
+            a.amax = o.max_acceleration.unwrap_or(params.arm.max_acceleration);
+            *vmax = lim.velocity * params.arm.velocity_limit_scale;
+            a.lower = lim.lower;
+            a.upper = lim.upper;
+        }
+        self.arm = joints;
+        self.vmax = vmax;
+        self.params = params;
+        self.arm_dt = f64::NAN; // recompute the cached steps
+        self.base_dt = f64::NAN;
+        Ok(())
+    }
+
+    /// The parameters in use.
+    pub fn params(&self) -> &ResolverParams {
+        &self.params
+    }
+
+    /// Model indices of the arm joints, in the order of [`Commands::joint_velocities`].
+    pub fn arm_joints(&self) -> &[usize] {
+        &self.arm_indices
+    }
+
+    /// Model indices of the base joints (x, y, yaw), if the model has a base.
+    pub fn base_joints(&self) -> Option<[usize; 3]> {
+        self.base
+    }
+
+    /// Commanded velocity limit of each arm joint \[rad/s\] (URDF limit times the scale).
+    pub fn arm_velocity_limits(&self) -> &[f64] {
+        &self.vmax
+    }
+
+    /// Acceleration limit of each arm joint \[rad/s²\].
+    pub fn arm_acceleration_limits(&self) -> impl Iterator<Item = f64> + '_ {
+        self.arm.iter().map(|a| a.amax)
+    }
+
+    /// The commands of the last step.
+    pub fn commands(&self) -> &Commands {
+        &self.commands
+    }
+
+    /// Starts from the measured state without a jump: virtual velocities and last commands =
+    /// measured velocities (`q_measured` gives the base yaw for the base-frame twist).
+    pub fn reset(&mut self, q_measured: &[f64], qd_measured: &[f64]) -> Result<(), ResolverError> {
+        self.check("q_measured", q_measured)?;
+        self.check("qd_measured", qd_measured)?;
+        for (v, a) in self.commands.joint_velocities.iter_mut().zip(&self.arm) {
+            *v = qd_measured[a.index];
+        }
+        if let Some(b) = self.base {
+            self.base_world = b.map(|j| qd_measured[j]);
+            self.commands.base_twist = to_base_frame(self.base_world, q_measured[b[2]]);
+        }
+        Ok(())
+    }
+
+    /// One step of the arms (all vectors in model order, length = number of model joints):
+    /// `tau` = τ* (N m), `gravity` = g (N m, used when `arm.subtract_gravity`), measured joint
+    /// positions and velocities. On invalid input the resolver takes one [`Resolver::safe_stop_arms`]
+    /// step (so [`Resolver::commands`] is a safe command to send) and returns the error.
+    pub fn update_arms(
+        &mut self,
+        tau: &[f64],
+        gravity: &[f64],
+        q_measured: &[f64],
+        qd_measured: &[f64],
+        dt_s: f64,
+    ) -> Result<&Commands, ResolverError> {
+        let checked = self
+            .check_dt(dt_s)
+            .and_then(|_| self.check("tau", tau))
+            .and_then(|_| self.check("gravity", gravity))
+            .and_then(|_| self.check("q_measured", q_measured))
+            .and_then(|_| self.check("qd_measured", qd_measured));
+        if let Err(e) = checked {
+            self.safe_stop_arms(dt_s);
+            return Err(e);
+        }
+        let dt = dt_s.min(MAX_DT_PERIODS / self.params.arm.rate_hz);
+        if dt != self.arm_dt {
+            for (s, a) in self.arm_steps.iter_mut().zip(&self.arm) {
+                *s = Step::new(a.inertia, a.damping, dt);
+            }
+            self.arm_dt = dt;
+        }
+        let sync = -(-self.params.arm.sync_gain_per_s * dt).exp_m1();
+        let g_factor = if self.params.arm.subtract_gravity {
+            1.0
+        } else {
+            0.0
+        };
+        let cmd = &mut self.commands.joint_velocities;
+        // Virtual dynamics into `target`: the rate limit needs the previous command.
+        let target = &mut self.target;
+        for (i, (a, s)) in self.arm.iter().zip(&self.arm_steps).enumerate() {
+            let j = a.index;
+            let v = cmd[i] + sync * (qd_measured[j] - cmd[i]);
+            let f = tau[j] - g_factor * gravity[j];
+            target[i] = finite_or_max(s.e * v + s.phi * f);
+        }
+        scale_chains(target, &self.vmax, &self.chain, &mut self.chain_scale);
+        for (i, a) in self.arm.iter().enumerate() {
+            let vmax = self.vmax[i];
+            let v = position_limit(target[i], q_measured[a.index], a.lower, a.upper, a.amax, dt);
+            // hard velocity limit last: only active when the previous command was above it
+            cmd[i] = rate_limit(cmd[i], v, a.amax * dt).clamp(-vmax, vmax);
+        }
+        Ok(&self.commands)
+    }
+
+    /// One step of the base: `tau` = τ* (its base entries are the world-frame forces along x, y
+    /// \[N\] and the yaw torque \[N m\]), measured positions (the yaw rotates between world and
+    /// base frame) and velocities (world frame, as the base joints'), all in model order.
+    /// A model without base leaves the zero twist. On invalid input: one
+    /// [`Resolver::safe_stop_base`] step and the error.
+    pub fn update_base(
+        &mut self,
+        tau: &[f64],
+        q_measured: &[f64],
+        qd_measured: &[f64],
+        dt_s: f64,
+    ) -> Result<&Commands, ResolverError> {
+        let checked = self
+            .check_dt(dt_s)
+            .and_then(|_| self.check("tau", tau))
+            .and_then(|_| self.check("q_measured", q_measured))
+            .and_then(|_| self.check("qd_measured", qd_measured));
+        if let Err(e) = checked {
+            self.safe_stop_base(dt_s);
+            return Err(e);
+        }
+        let Some([ix, iy, iyaw]) = self.base else {
+            return Ok(&self.commands);
+        };
+        let p = &self.params.base;
+        let dt = dt_s.min(MAX_DT_PERIODS / p.rate_hz);
+        if dt != self.base_dt {
+            for k in 0..3 {
+                self.base_steps[k] = Step::new(p.inertia[k], p.damping[k], dt);
+            }
+            self.base_dt = dt;
+        }
+        let sync = -(-p.sync_gain_per_s * dt).exp_m1();
+        let yaw = q_measured[iyaw];
+        let prev = self.base_world;
+        let measured = [qd_measured[ix], qd_measured[iy], qd_measured[iyaw]];
+        let v: [f64; 3] = core::array::from_fn(|k| prev[k] + sync * (measured[k] - prev[k]));
+        // eq. (26) lower row in the base frame, where M_b and D_b are constant
+        let vb = to_base_frame(v, yaw);
+        let fb = to_base_frame([tau[ix], tau[iy], tau[iyaw]], yaw);
+        let s = &self.base_steps;
+        let vb: [f64; 3] =
+            core::array::from_fn(|k| finite_or_max(s[k].e * vb[k] + s[k].phi * fb[k]));
+        // limits (norms are frame independent); the rate limit acts on the world-frame velocity,
+        // the base's physical acceleration
+        let lin = clamp_norm([vb[0], vb[1]], p.max_linear_m_s);
+        let w = vb[2].clamp(-p.max_angular_rad_s, p.max_angular_rad_s);
+        let target = to_world_frame([lin[0], lin[1], w], yaw);
+        let step = clamp_norm(
+            [target[0] - prev[0], target[1] - prev[1]],
+            p.max_linear_accel_m_s2 * dt,
+        );
+        let lin = clamp_norm([prev[0] + step[0], prev[1] + step[1]], p.max_linear_m_s);
+        let w = rate_limit(prev[2], target[2], p.max_angular_accel_rad_s2 * dt)
+            .clamp(-p.max_angular_rad_s, p.max_angular_rad_s);
+        self.base_world = [lin[0], lin[1], w];
+        self.commands.base_twist = to_base_frame(self.base_world, yaw);
+        Ok(&self.commands)
+    }
+
+    /// [`Resolver::update_arms`] and [`Resolver::update_base`] with one `dt` (both parts at one
+    /// rate). Both parts are stepped even if one fails; the first error is returned.
+    pub fn update(
+        &mut self,
+        tau: &[f64],
+        gravity: &[f64],
+        q_measured: &[f64],
+        qd_measured: &[f64],
+        dt_s: f64,
+    ) -> Result<&Commands, ResolverError> {
+        let arms = self
+            .update_arms(tau, gravity, q_measured, qd_measured, dt_s)
+            .map(|_| ());
+        let base = self
+            .update_base(tau, q_measured, qd_measured, dt_s)
+            .map(|_| ());
+        arms.and(base)?;
+        Ok(&self.commands)
+    }
+
+    /// One step of the safe stop of the arms: every joint command decelerates towards zero at its
+    /// acceleration limit (an invalid `dt_s` counts as one nominal period). The virtual state
+    /// follows, so a later valid update continues without a jump.
+    pub fn safe_stop_arms(&mut self, dt_s: f64) -> &Commands {
+        let dt = self.safe_dt(dt_s, self.params.arm.rate_hz);
+        for (v, a) in self.commands.joint_velocities.iter_mut().zip(&self.arm) {
+            *v = rate_limit(*v, 0.0, a.amax * dt);
+        }
+        // a joint above a lowered velocity limit (set_params) is brought within it too
+        for (v, &vmax) in self.commands.joint_velocities.iter_mut().zip(&self.vmax) {
+            *v = v.clamp(-vmax, vmax);
+        }
+        &self.commands
+    }
+
+    /// One step of the safe stop of the base: the planar velocity decelerates along its direction
+    /// and the yaw rate towards zero, within the base's acceleration limits. The twist is
+    /// expressed with the yaw of the last valid update.
+    pub fn safe_stop_base(&mut self, dt_s: f64) -> &Commands {
+        let p = &self.params.base;
+        let dt = self.safe_dt(dt_s, p.rate_hz);
+        let v = self.base_world;
+        let step = clamp_norm([-v[0], -v[1]], p.max_linear_accel_m_s2 * dt);
+        let w = rate_limit(v[2], 0.0, p.max_angular_accel_rad_s2 * dt);
+        // the twist's base-frame direction is unchanged by a common scaling
+        let (old, new) = (v[0].hypot(v[1]), (v[0] + step[0]).hypot(v[1] + step[1]));
+        let s = if old > 0.0 { new / old } else { 0.0 };
+        let t = self.commands.base_twist;
+        self.base_world = [v[0] + step[0], v[1] + step[1], w];
+        self.commands.base_twist = [t[0] * s, t[1] * s, w];
+        &self.commands
+    }
+
+    /// One safe-stop step of arms and base with one `dt` (see [`Resolver::safe_stop_arms`],
+    /// [`Resolver::safe_stop_base`]).
+    pub fn safe_stop(&mut self, dt_s: f64) -> &Commands {
+        self.safe_stop_arms(dt_s);
+        self.safe_stop_base(dt_s)
+    }
+
+    fn safe_dt(&self, dt_s: f64, rate_hz: f64) -> f64 {
+        let nominal = 1.0 / rate_hz;
+        if dt_s.is_finite() && dt_s > 0.0 {
+            dt_s.min(MAX_DT_PERIODS * nominal)
+        } else {
+            nominal
+        }
+    }
+
+    fn check_dt(&self, dt_s: f64) -> Result<(), ResolverError> {
+        if dt_s.is_finite() && dt_s > 0.0 {
+            Ok(())
+        } else {
+            Err(ResolverError::InvalidDt(dt_s))
+        }
+    }
+
+    fn check(&self, what: &'static str, x: &[f64]) -> Result<(), ResolverError> {
+        if x.len() != self.nv {
+            return Err(ResolverError::Dimension {
+                what,
+                expected: self.nv,
+                got: x.len(),
+            });
+        }
+        match x.iter().position(|v| !v.is_finite()) {
+            Some(index) => Err(ResolverError::NonFinite {
+                what,
+                index,
+                value: x[index],
+            }),
+            None => Ok(()),
+        }
+    }
+}
+
+/// World-frame planar velocity `(vx, vy, wz)` expressed in a frame rotated by `yaw` (rotation by
+/// `-yaw`); `wz` is the same in both.
+fn to_base_frame(v: [f64; 3], yaw: f64) -> [f64; 3] {
+    let (s, c) = yaw.sin_cos();
+    [c * v[0] + s * v[1], -s * v[0] + c * v[1], v[2]]
+}
+
+/// Inverse of [`to_base_frame`].
+fn to_world_frame(v: [f64; 3], yaw: f64) -> [f64; 3] {
+    let (s, c) = yaw.sin_cos();
+    [c * v[0] - s * v[1], s * v[0] + c * v[1], v[2]]
+}

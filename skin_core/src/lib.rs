@@ -8,8 +8,14 @@
 //! - [`hierarchy`]: the multi-priority torque solver (paper 003 eq. 19-25, with paper 000's
 //!   task-space force levels): ordered [`hierarchy::TaskLevel`]s and a posture torque in, joint
 //!   torque out, with damped, rank-aware inverses.
+//! - [`resolver`]: the admittance torque resolver (paper 003 eq. 26): torques to joint and base
+//!   velocity commands within the limits.
+//! - [`supervisor`]: which arrangement of tasks is active (paper 000 Table I, paper 003 Table 1)
+//!   and the smooth switch between them (paper 000 eq. 10-11).
 #![warn(missing_docs)]
 
 pub mod hierarchy;
 pub mod model;
+pub mod resolver;
 pub mod skin;
+pub mod supervisor;

@@ -1,6 +1,6 @@
 //! The control loop runs at kHz rates: after setup, kinematics and dynamics, the skin's per-cycle
-//! functions and the hierarchy must not touch the heap. A counting global allocator checks that
-//! (one test binary, since a binary has one global allocator).
+//! functions, the hierarchy, the resolver, the supervisor and the torque blender must not touch the
+//! heap. A counting global allocator checks that (one test binary: a binary has one allocator).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -16,6 +16,8 @@ use skin_core::skin::params::SkinParams;
 use skin_core::skin::signals::CellReading;
 use skin_core::skin::torques::{patch_wrenches_to_torques, point_forces_to_torques};
 use skin_core::skin::transforms::{patch_poses_world, patch_wrench_world, sum_patch_forces_in_frame};
+use skin_core::resolver::{Resolver, ResolverParams};
+use skin_core::supervisor::*;
 
 struct Counting;
 
@@ -206,4 +208,82 @@ fn hierarchy_does_not_allocate_after_setup() {
     }
     let after = allocations();
     assert_eq!(after - before, 0, "{} heap allocations in the hierarchy loop", after - before);
+}
+
+#[test]
+fn supervisor_and_blend_do_not_allocate() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../config/supervisor.yaml");
+    let params = SupervisorParams::load(std::path::Path::new(path)).unwrap();
+    let mut sup = Supervisor::new(&params, 0.0).unwrap();
+    let mut blender = TorqueBlender::new(15);
+    let tau_a = [1.0; 15];
+    let tau_b = [-2.0; 15];
+    let mut out = [0.0; 15];
+    let before = allocations();
+    let mut t = 0.0;
+    for k in 0..5000 {
+        t += 0.004;
+        let s = (k % 1000) as f64 / 1000.0;
+        let u = SupervisorInput {
+            ee_speed_mps: if s < 0.3 { 0.0 } else { 0.05 },
+            avoidance_force_n: 3.0,
+            contact_force_n: if (0.4..0.5).contains(&s) { 8.0 } else { 0.0 },
+            goal_error_m: if s < 0.8 { 0.2 } else { 0.0 },
+        };
+        let a = sup.update(t, &u);
+        blender.sync(a);
+        let tau = if a.mode == Mode::Avoidance {
+            &tau_a
+        } else {
+            &tau_b
+        };
+        blender.apply(t, tau, &mut out);
+    }
+    let after = allocations();
+    assert!(
+        sup.log().total() >= 10,
+        "the scenario must switch: {}",
+        sup.log().total()
+    );
+    assert_eq!(after - before, 0, "allocations during updates");
+}
+
+#[test]
+fn resolver_cycle_does_not_allocate_after_setup() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let model = RobotModel::from_urdf_file(&root.join("urdf/tomm.urdf")).unwrap();
+    let params = ResolverParams::load(&root.join("config/resolver.yaml")).unwrap();
+    let mut r = Resolver::new(&model, params).unwrap();
+    let n = model.nv();
+    let q: Vec<f64> = (0..n).map(|i| 0.1 * i as f64 - 0.5).collect();
+    let qd: Vec<f64> = (0..n).map(|i| 0.05 * i as f64 - 0.3).collect();
+    let mut tau: Vec<f64> = (0..n).map(|i| 1e3 * i as f64).collect();
+    let g = vec![1.0; n];
+    let mut cycle = |r: &mut Resolver, k: usize| {
+        r.reset(&q, &qd).unwrap();
+        tau[k % n] = -tau[k % n];
+        r.update_arms(&tau, &g, &q, &qd, 0.008).unwrap();
+        r.update_base(&tau, &q, &qd, 0.001).unwrap();
+        r.update(&tau, &g, &q, &qd, 0.002 + 1e-4 * k as f64)
+            .unwrap();
+        // the error path too (its error carries no heap data)
+        let bad = tau[3];
+        tau[3] = f64::NAN;
+        assert!(r.update(&tau, &g, &q, &qd, 0.008).is_err());
+        tau[3] = bad;
+        r.safe_stop(0.008);
+    };
+    cycle(&mut r, 0); // warm-up
+    let probe = allocations();
+    std::hint::black_box(vec![1u8; 16]);
+    assert!(allocations() > probe, "the counter sees heap allocations");
+    let before = allocations();
+    for k in 1..20 {
+        cycle(&mut r, k);
+    }
+    assert_eq!(
+        allocations() - before,
+        0,
+        "heap allocations in the resolver cycle"
+    );
 }

@@ -1,0 +1,299 @@
+//! The supervisor state machine: paper 000 Table I switched on sensed conditions, or the paper
+//! 003 Table 1 phases switched on request. The exact rules are in `docs/supervisor.md`.
+
+use super::blend::WeightShift;
+use super::log::TransitionLog;
+use super::params::{
+    DwellTimes, FusionShift, ParamError, Policy, SensingRange, SupervisorParams, Thresholds,
+};
+use super::types::{Arrangement, Cause, Mode, Phase, PhaseRefused, SupervisorInput, Transition};
+
+/// A condition that must hold for a dwell time, with a hysteresis between the condition that
+/// starts the timer (`set`) and the weaker one that keeps it running (`keep`).
+#[derive(Debug, Clone, Copy)]
+struct Dwell {
+    /// Start of the current holding interval; NaN when not holding.
+    since: f64,
+}
+
+impl Dwell {
+    const IDLE: Dwell = Dwell { since: f64::NAN };
+
+    /// Advances to `t` and returns whether the condition has held for `dwell_s`.
+    fn step(&mut self, t: f64, set: bool, keep: bool, dwell_s: f64) -> bool {
+        if self.since.is_nan() {
+            if set {
+                self.since = t;
+            }
+        } else if !(keep || set) {
+            self.since = f64::NAN;
+        }
+        !self.since.is_nan() && t - self.since >= dwell_s
+    }
+}
+
+/// The priority supervisor. Allocates in [`Supervisor::new`] only.
+#[derive(Debug, Clone)]
+pub struct Supervisor {
+    policy: Policy,
+    thresholds: Thresholds,
+    dwell: DwellTimes,
+    range: SensingRange,
+    fusion: FusionShift,
+    tasks: Vec<String>,
+    orders: [Vec<usize>; 5],
+    arrangement: Arrangement,
+    /// The mode (a) or (b) to return to when a hard contact (c) is released.
+    resume: Mode,
+    over_limit: Dwell,
+    released: Dwell,
+    stuck: Dwell,
+    goal_reached: Dwell,
+    cleared: Dwell,
+    invalid: Dwell,
+    pending: Option<Phase>,
+    weight: WeightShift,
+    last_t: f64,
+    last_transition: Option<Transition>,
+    log: TransitionLog,
+}
+
+impl Supervisor {
+    /// A supervisor at time `t0_s` in the initial mode of the policy: (a) avoidance for paper
+    /// 000, precontact for paper 003. `t0_s` is the initial switch time.
+    pub fn new(params: &SupervisorParams, t0_s: f64) -> Result<Self, ParamError> {
+        params.validate()?;
+        let orders = params.task_indices()?;
+        let capacity = orders.iter().map(Vec::len).max().unwrap_or(0);
+        let mode = match params.policy {
+            Policy::IntentionalContact => Mode::Avoidance,
+            Policy::Phases => Mode::PreContact,
+        };
+        let mut task_order = Vec::with_capacity(capacity);
+        task_order.extend_from_slice(&orders[mode as usize]);
+        let t0 = if t0_s.is_finite() { t0_s } else { 0.0 };
+        let w = params.fusion.w_precontact;
+        Ok(Supervisor {
+            policy: params.policy,
+            thresholds: params.thresholds,
+            dwell: params.dwell,
+            range: params.sensing_range,
+            fusion: params.fusion,
+            tasks: params.tasks.clone(),
+            orders,
+            arrangement: Arrangement {
+                mode,
+                task_order,
+                switch_time_s: t0,
+                smoothing_gain_per_s: params.smoothing_gain_per_s,
+                sensing_range_m: params.sensing_range.nominal_m,
+                fusion_weight: w,
+                fusion_weight_target: w,
+            },
+            resume: Mode::Avoidance,
+            over_limit: Dwell::IDLE,
+            released: Dwell::IDLE,
+            stuck: Dwell::IDLE,
+            goal_reached: Dwell::IDLE,
+            cleared: Dwell::IDLE,
+            invalid: Dwell::IDLE,
+            pending: None,
+            weight: WeightShift::constant(w),
+            last_t: t0,
+            last_transition: None,
+            log: TransitionLog::new(params.log_capacity),
+        })
+    }
+
+    /// Advances to `t_s` with the sensed `input` and returns the active arrangement.
+    ///
+    /// `t_s` should not decrease; a non-finite `t_s` is replaced by the previous update time.
+    /// NaN inputs are treated conservatively, toward the safer arrangement:
+    /// - NaN contact force counts as `‖F_c‖ ≥ ε_c` (enters/keeps hard contact (c));
+    /// - NaN speed, obstacle force or goal error never count as stuck (no (a) → (b)), and in (b)
+    ///   they count toward returning to avoidance (a) after `dwell.clear_s`.
+    pub fn update(&mut self, t_s: f64, input: &SupervisorInput) -> &Arrangement {
+        let t = if t_s.is_finite() { t_s } else { self.last_t };
+        let dt = (t - self.last_t).max(0.0);
+        self.last_t = t;
+        self.last_transition = None;
+        match self.policy {
+            Policy::IntentionalContact => self.step_table_i(t, input),
+            Policy::Phases => self.step_phases(t),
+        }
+        self.ramp_range(dt);
+        self.arrangement.fusion_weight = self.weight.at(t);
+        &self.arrangement
+    }
+
+    /// Requests a paper 003 phase; it takes effect at the next [`Self::update`] (whose time is
+    /// the switch time). Refused under the paper 000 policy, which switches on sensed
+    /// conditions only. Requesting the active phase is accepted and changes nothing.
+    pub fn request_phase(&mut self, phase: Phase) -> Result<(), PhaseRefused> {
+        match self.policy {
+            Policy::Phases => {
+                self.pending = Some(phase);
+                Ok(())
+            }
+            Policy::IntentionalContact => Err(PhaseRefused {
+                reason: "the intentional_contact policy (paper 000 Table I) switches on sensed \
+                         conditions only; configure `policy: phases` to request phases",
+            }),
+        }
+    }
+
+    /// The active arrangement.
+    pub fn arrangement(&self) -> &Arrangement {
+        &self.arrangement
+    }
+
+    /// The active mode.
+    pub fn mode(&self) -> Mode {
+        self.arrangement.mode
+    }
+
+    /// The configured policy.
+    pub fn policy(&self) -> Policy {
+        self.policy
+    }
+
+    /// The configured task names ([`Arrangement::task_order`] indexes into them).
+    pub fn tasks(&self) -> &[String] {
+        &self.tasks
+    }
+
+    /// The transition made by the last [`Self::update`], if any.
+    pub fn last_transition(&self) -> Option<Transition> {
+        self.last_transition
+    }
+
+    /// The transition log (ring buffer of the latest transitions).
+    pub fn log(&self) -> &TransitionLog {
+        &self.log
+    }
+
+    /// Paper 000 Table I with dwell times and hysteresis (rules in `docs/supervisor.md`).
+    fn step_table_i(&mut self, t: f64, u: &SupervisorInput) {
+        let th = self.thresholds;
+        let dw = self.dwell;
+        let fc = u.contact_force_n;
+        let over = fc.is_nan() || fc >= th.contact_force_n; // NaN counts as over the limit
+        let below = fc < th.contact_force_n - th.contact_band_n; // NaN is never below
+        let (v, fd, ge) = (u.ee_speed_mps, u.avoidance_force_n, u.goal_error_m);
+        let invalid = v.is_nan() || fd.is_nan() || ge.is_nan();
+        let mode = self.arrangement.mode;
+        match mode {
+            Mode::Avoidance | Mode::IntentionalContact => {
+                // A hard contact can happen in (a) or (b): checked first, it has priority.
+                if self.over_limit.step(t, over, over, dw.hard_contact_s) {
+                    self.resume = mode;
+                    self.switch(t, Mode::HardContact, Cause::ContactOverLimit);
+                    return;
+                }
+                if mode == Mode::Avoidance {
+                    let set = v <= th.speed_mps
+                        && fd > th.obstacle_force_n + th.obstacle_band_n
+                        && ge > th.goal_tolerance_m + th.goal_band_m;
+                    let keep = v <= th.speed_mps + th.speed_band_mps
+                        && fd > th.obstacle_force_n
+                        && ge > th.goal_tolerance_m;
+                    if self.stuck.step(t, set, keep, dw.stuck_s) {
+                        self.switch(t, Mode::IntentionalContact, Cause::Stuck);
+                    }
+                } else {
+                    let reached = ge <= th.goal_tolerance_m;
+                    let clear = fd <= th.obstacle_force_n;
+                    // Every timer advances every cycle; then the first that has held wins.
+                    let g = self
+                        .goal_reached
+                        .step(t, reached, reached, dw.goal_reached_s);
+                    let c = self.cleared.step(t, clear, clear, dw.clear_s);
+                    let i = self.invalid.step(t, invalid, invalid, dw.clear_s);
+                    let cause = if g {
+                        Some(Cause::GoalReached)
+                    } else if c {
+                        Some(Cause::ObstacleCleared)
+                    } else if i {
+                        Some(Cause::InvalidInput)
+                    } else {
+                        None
+                    };
+                    if let Some(cause) = cause {
+                        self.switch(t, Mode::Avoidance, cause);
+                    }
+                }
+            }
+            Mode::HardContact => {
+                if self.released.step(t, below, below, dw.contact_release_s) {
+                    self.switch(t, self.resume, Cause::ContactReleased);
+                }
+            }
+            // Not reachable under this policy; nothing to do.
+            Mode::PreContact | Mode::Contact => {}
+        }
+    }
+
+    /// Paper 003 Table 1: a pending request switches the phase and starts the weight shift
+    /// from the current `w` (so a reversal mid-shift is continuous too).
+    fn step_phases(&mut self, t: f64) {
+        let Some(phase) = self.pending.take() else {
+            return;
+        };
+        let to = phase.mode();
+        if to == self.arrangement.mode {
+            return;
+        }
+        let target = match phase {
+            Phase::PreContact => self.fusion.w_precontact,
+            Phase::Contact => self.fusion.w_contact,
+        };
+        let now = self.weight.at(t);
+        self.weight = WeightShift::new(now, target, t, self.fusion.duration_s, self.fusion.gain);
+        self.arrangement.fusion_weight_target = target;
+        self.switch(t, to, Cause::PhaseRequest);
+    }
+
+    /// Sensing range ramp (paper 000 Sec. III: reduced gradually during intentional contact):
+    /// toward `intentional_contact_m` in (b), back to nominal in (a) and the paper 003 phases,
+    /// held in (c).
+    fn ramp_range(&mut self, dt: f64) {
+        let target = match self.arrangement.mode {
+            Mode::IntentionalContact => self.range.intentional_contact_m,
+            Mode::HardContact => return,
+            Mode::Avoidance | Mode::PreContact | Mode::Contact => self.range.nominal_m,
+        };
+        let r = &mut self.arrangement.sensing_range_m;
+        *r = if *r > target {
+            (*r - self.range.shrink_rate_mps * dt).max(target)
+        } else {
+            (*r + self.range.restore_rate_mps * dt).min(target)
+        };
+    }
+
+    fn switch(&mut self, t: f64, to: Mode, cause: Cause) {
+        let from = self.arrangement.mode;
+        let a = &mut self.arrangement;
+        a.mode = to;
+        a.task_order.clear();
+        a.task_order.extend_from_slice(&self.orders[to as usize]); // within reserved capacity
+        a.switch_time_s = t;
+        for d in [
+            &mut self.over_limit,
+            &mut self.released,
+            &mut self.stuck,
+            &mut self.goal_reached,
+            &mut self.cleared,
+            &mut self.invalid,
+        ] {
+            *d = Dwell::IDLE;
+        }
+        let tr = Transition {
+            t_s: t,
+            from,
+            to,
+            cause,
+        };
+        self.last_transition = Some(tr);
+        self.log.push(tr);
+    }
+}

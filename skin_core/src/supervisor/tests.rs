@@ -1,0 +1,667 @@
+use std::path::PathBuf;
+
+use super::blend::{chi, step_bound};
+use super::*;
+
+const DT: f64 = 0.004; // 250 Hz
+
+fn shipped() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../config/supervisor.yaml")
+}
+
+fn params() -> SupervisorParams {
+    SupervisorParams::load(&shipped()).expect("shipped supervisor.yaml")
+}
+
+fn phases_params() -> SupervisorParams {
+    let mut p = params();
+    p.policy = Policy::Phases;
+    p
+}
+
+/// Deterministic splitmix64 → uniform [-1, 1).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    }
+}
+
+fn input(v: f64, fd: f64, fc: f64, ge: f64) -> SupervisorInput {
+    SupervisorInput {
+        ee_speed_mps: v,
+        avoidance_force_n: fd,
+        contact_force_n: fc,
+        goal_error_m: ge,
+    }
+}
+
+/// Runs `steps` cycles of `u` from `*t`; returns the transitions seen.
+fn run(sup: &mut Supervisor, t: &mut f64, steps: usize, u: SupervisorInput) -> Vec<Transition> {
+    let mut out = Vec::new();
+    for _ in 0..steps {
+        *t += DT;
+        sup.update(*t, &u);
+        out.extend(sup.last_transition());
+    }
+    out
+}
+
+fn stuck() -> SupervisorInput {
+    input(0.0, 3.0, 0.0, 0.2)
+}
+
+/// Drives the paper 000 supervisor into (b).
+fn into_b(sup: &mut Supervisor, t: &mut f64) {
+    let tr = run(sup, t, 200, stuck());
+    assert_eq!(tr.len(), 1, "{tr:?}");
+    assert_eq!(sup.mode(), Mode::IntentionalContact);
+}
+
+#[test]
+fn shipped_config_loads_and_mirrors_table_i() {
+    let p = params();
+    let sup = Supervisor::new(&p, 0.0).unwrap();
+    assert_eq!(sup.mode(), Mode::Avoidance);
+    let names: Vec<&str> = sup.arrangement().task_names(sup.tasks()).collect();
+    assert_eq!(names, ["avoidance", "goal", "contact_reaction"]);
+    for (i, m) in Mode::ALL.iter().enumerate() {
+        assert_eq!(m.as_u8() as usize, i);
+        assert_eq!(Mode::from_u8(i as u8), Some(*m));
+    }
+    assert_eq!(Mode::from_u8(5), None);
+}
+
+#[test]
+fn stuck_switches_a_to_b_after_dwell() {
+    let p = params();
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    let tr = run(&mut sup, &mut t, 200, stuck());
+    assert_eq!(tr.len(), 1);
+    assert_eq!(
+        (tr[0].from, tr[0].to, tr[0].cause),
+        (Mode::Avoidance, Mode::IntentionalContact, Cause::Stuck)
+    );
+    // First sample at DT starts the dwell; the switch comes once stuck_s has elapsed.
+    assert!(
+        (tr[0].t_s - DT - p.dwell.stuck_s).abs() < DT + 1e-9,
+        "{}",
+        tr[0].t_s
+    );
+    assert_eq!(sup.arrangement().switch_time_s, tr[0].t_s);
+    let names: Vec<&str> = sup.arrangement().task_names(sup.tasks()).collect();
+    assert_eq!(names, ["goal", "contact_reaction", "avoidance"]);
+}
+
+#[test]
+fn no_switch_to_b_when_moving_or_clear_or_at_goal() {
+    let p = params();
+    for u in [
+        input(0.05, 3.0, 0.0, 0.2),  // moving
+        input(0.0, 0.0, 0.0, 0.2),   // nothing in range
+        input(0.0, 3.0, 0.0, 0.005), // goal reached
+    ] {
+        let mut sup = Supervisor::new(&p, 0.0).unwrap();
+        let mut t = 0.0;
+        assert!(run(&mut sup, &mut t, 1000, u).is_empty(), "{u:?}");
+    }
+}
+
+#[test]
+fn contact_over_limit_b_to_c_and_release_back_to_b() {
+    let p = params();
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    into_b(&mut sup, &mut t);
+    let tr = run(&mut sup, &mut t, 10, input(0.0, 0.0, 6.0, 0.2));
+    assert_eq!(tr.len(), 1);
+    assert_eq!(
+        (tr[0].from, tr[0].to),
+        (Mode::IntentionalContact, Mode::HardContact)
+    );
+    assert_eq!(tr[0].cause, Cause::ContactOverLimit);
+    let names: Vec<&str> = sup.arrangement().task_names(sup.tasks()).collect();
+    assert_eq!(names, ["contact_reaction", "goal", "avoidance"]);
+    // Below eps_c but inside the band: stays in (c).
+    assert!(run(&mut sup, &mut t, 500, input(0.0, 0.0, 4.0, 0.2)).is_empty());
+    // Below eps_c - band, for the dwell: back to (b).
+    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 2.0, 0.2));
+    assert_eq!(tr.len(), 1);
+    assert_eq!(
+        (tr[0].from, tr[0].to, tr[0].cause),
+        (
+            Mode::HardContact,
+            Mode::IntentionalContact,
+            Cause::ContactReleased
+        )
+    );
+}
+
+#[test]
+fn hard_contact_from_a_returns_to_a() {
+    let p = params();
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    let tr = run(&mut sup, &mut t, 1, input(0.1, 0.0, 5.0, 0.2));
+    assert_eq!((tr[0].from, tr[0].to), (Mode::Avoidance, Mode::HardContact));
+    let tr = run(&mut sup, &mut t, 200, input(0.1, 0.0, 0.0, 0.2));
+    assert_eq!((tr[0].from, tr[0].to), (Mode::HardContact, Mode::Avoidance));
+}
+
+#[test]
+fn goal_reached_or_cleared_b_to_a() {
+    let p = params();
+    for (u, cause) in [
+        (input(0.0, 3.0, 0.0, 0.005), Cause::GoalReached),
+        (input(0.05, 0.0, 0.0, 0.2), Cause::ObstacleCleared),
+        (input(f64::NAN, 3.0, 0.0, 0.2), Cause::InvalidInput),
+    ] {
+        let mut sup = Supervisor::new(&p, 0.0).unwrap();
+        let mut t = 0.0;
+        into_b(&mut sup, &mut t);
+        let tr = run(&mut sup, &mut t, 300, u);
+        assert_eq!(tr.len(), 1, "{u:?}");
+        assert_eq!(
+            (tr[0].from, tr[0].to, tr[0].cause),
+            (Mode::IntentionalContact, Mode::Avoidance, cause)
+        );
+    }
+}
+
+#[test]
+fn sensing_range_shrinks_gradually_in_b_and_is_restored_in_a() {
+    let p = params();
+    let r = p.sensing_range;
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    into_b(&mut sup, &mut t);
+    let mut prev = sup.arrangement().sensing_range_m;
+    let mut hit_zero_at = None;
+    for _ in 0..1000 {
+        t += DT;
+        let a = sup.update(t, &stuck());
+        let d = prev - a.sensing_range_m;
+        assert!(
+            (-1e-15..=r.shrink_rate_mps * DT + 1e-12).contains(&d),
+            "step {d}"
+        );
+        prev = a.sensing_range_m;
+        if prev == r.intentional_contact_m && hit_zero_at.is_none() {
+            hit_zero_at = Some(t);
+        }
+    }
+    assert_eq!(prev, r.intentional_contact_m);
+    assert!(hit_zero_at.is_some());
+    // Goal reached -> (a); the range comes back gradually to nominal.
+    let tr = run(&mut sup, &mut t, 100, input(0.0, 3.0, 0.0, 0.0));
+    assert_eq!(tr[0].to, Mode::Avoidance);
+    prev = sup.arrangement().sensing_range_m;
+    for _ in 0..1000 {
+        t += DT;
+        let a = sup.update(t, &input(0.0, 3.0, 0.0, 0.0));
+        let d = a.sensing_range_m - prev;
+        assert!((-1e-15..=r.restore_rate_mps * DT + 1e-12).contains(&d));
+        prev = a.sensing_range_m;
+    }
+    assert_eq!(prev, r.nominal_m);
+}
+
+/// Noise uniform ±20 % of the threshold around each threshold causes at most the expected
+/// transition.
+#[test]
+fn noise_around_thresholds_does_not_chatter() {
+    let p = params();
+    let th = p.thresholds;
+    let n = 5000;
+    let mut rng = Rng(42);
+
+    // Speed around eps_v in (a), obstacle in range, goal far: at most the one (a) -> (b).
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    let mut count = 0;
+    for _ in 0..n {
+        t += DT;
+        let v = th.speed_mps * (1.0 + 0.2 * rng.next());
+        sup.update(t, &input(v, 3.0, 0.0, 0.2));
+        count += sup.last_transition().is_some() as usize;
+    }
+    assert!(count <= 1, "speed noise: {count}");
+
+    // Contact force around eps_c in (b): one (b) -> (c), never back (band 30 % > noise).
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    into_b(&mut sup, &mut t);
+    let base = sup.log().total();
+    for _ in 0..n {
+        t += DT;
+        let fc = th.contact_force_n * (1.0 + 0.2 * rng.next());
+        sup.update(t, &input(0.0, 3.0, fc, 0.2));
+    }
+    assert_eq!(sup.log().total() - base, 1, "contact noise");
+    assert_eq!(sup.mode(), Mode::HardContact);
+
+    // Contact force around the release level eps_c - band in (c): at most one way back.
+    let release = th.contact_force_n - th.contact_band_n;
+    let base = sup.log().total();
+    for _ in 0..n {
+        t += DT;
+        let fc = release + 0.2 * th.contact_force_n * rng.next();
+        sup.update(t, &input(0.0, 3.0, fc, 0.2));
+    }
+    assert!(sup.log().total() - base <= 1, "release noise");
+
+    // Goal error around the tolerance in (b): at most one (b) -> (a), no re-entry.
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    into_b(&mut sup, &mut t);
+    let base = sup.log().total();
+    for _ in 0..n {
+        t += DT;
+        let ge = th.goal_tolerance_m * (1.0 + 0.2 * rng.next());
+        sup.update(t, &input(0.0, 3.0, 0.0, ge));
+    }
+    assert!(sup.log().total() - base <= 1, "goal noise");
+
+    // Obstacle force around the in-range level in (a) while stopped: at most one (a) -> (b).
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    let level = th.obstacle_force_n + th.obstacle_band_n;
+    for _ in 0..n {
+        t += DT;
+        let fd = level * (1.0 + 0.2 * rng.next());
+        sup.update(t, &input(0.0, fd, 0.0, 0.2));
+    }
+    assert!(sup.log().total() <= 1, "obstacle noise");
+}
+
+#[test]
+fn nan_contact_counts_as_over_limit_and_blocks_release() {
+    let p = params();
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    let tr = run(&mut sup, &mut t, 1, input(0.0, 0.0, f64::NAN, 0.2));
+    assert_eq!(tr[0].to, Mode::HardContact);
+    assert!(run(&mut sup, &mut t, 1000, input(0.0, 0.0, f64::NAN, 0.2)).is_empty());
+}
+
+#[test]
+fn nan_speed_or_goal_never_counts_as_stuck() {
+    let p = params();
+    for u in [
+        input(f64::NAN, 3.0, 0.0, 0.2),
+        input(0.0, f64::NAN, 0.0, 0.2),
+        input(0.0, 3.0, 0.0, f64::NAN),
+    ] {
+        let mut sup = Supervisor::new(&p, 0.0).unwrap();
+        let mut t = 0.0;
+        assert!(run(&mut sup, &mut t, 1000, u).is_empty(), "{u:?}");
+    }
+}
+
+#[test]
+fn nan_time_is_replaced_by_previous_time() {
+    let p = params();
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    sup.update(f64::NAN, &stuck());
+    sup.update(0.1, &stuck());
+    sup.update(f64::INFINITY, &stuck());
+    assert_eq!(sup.mode(), Mode::Avoidance);
+    assert!(sup.arrangement().sensing_range_m.is_finite());
+}
+
+#[test]
+fn phase_requests_refused_under_paper_000_policy() {
+    let p = params();
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let e = sup.request_phase(Phase::Contact).unwrap_err();
+    assert!(e.to_string().contains("policy"), "{e}");
+    sup.update(0.1, &SupervisorInput::default());
+    assert_eq!(sup.mode(), Mode::Avoidance);
+}
+
+#[test]
+fn phases_switch_on_request_and_weight_follows_sigmoid() {
+    let p = phases_params();
+    let f = p.fusion;
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    assert_eq!(sup.mode(), Mode::PreContact);
+    let names: Vec<&str> = sup.arrangement().task_names(sup.tasks()).collect();
+    assert_eq!(
+        names,
+        [
+            "hand_distance",
+            "wrist",
+            "tactile_guidance",
+            "base_avoidance",
+            "posture"
+        ]
+    );
+    let u = SupervisorInput::default();
+    let mut t = 0.0;
+    // No switch without a request, whatever the sensed signals.
+    assert!(run(&mut sup, &mut t, 100, input(0.0, 3.0, 50.0, 0.2)).is_empty());
+    sup.request_phase(Phase::Contact).unwrap();
+    t += DT;
+    sup.update(t, &u);
+    let tr = sup.last_transition().unwrap();
+    assert_eq!(
+        (tr.from, tr.to, tr.cause),
+        (Mode::PreContact, Mode::Contact, Cause::PhaseRequest)
+    );
+    assert_eq!(sup.arrangement().fusion_weight, f.w_precontact);
+    assert_eq!(sup.arrangement().fusion_weight_target, f.w_contact);
+    let names: Vec<&str> = sup.arrangement().task_names(sup.tasks()).collect();
+    assert_eq!(
+        names,
+        [
+            "hand_force",
+            "wrist",
+            "position_hold",
+            "base_avoidance",
+            "compliance",
+            "posture"
+        ]
+    );
+    let mut prev = sup.arrangement().fusion_weight;
+    let mut max_step: f64 = 0.0;
+    let steps = (f.duration_s / DT) as usize + 10;
+    for _ in 0..steps {
+        t += DT;
+        let w = sup.update(t, &u).fusion_weight;
+        assert!(w >= prev - 1e-15, "not monotonic: {prev} -> {w}");
+        max_step = max_step.max(w - prev);
+        prev = w;
+    }
+    assert_eq!(prev, f.w_contact);
+    assert!(max_step < 0.05, "weight step {max_step}");
+    // Same phase again: accepted, no transition.
+    sup.request_phase(Phase::Contact).unwrap();
+    assert!(run(&mut sup, &mut t, 1, u).is_empty());
+    // Back to precontact: w returns monotonically.
+    sup.request_phase(Phase::PreContact).unwrap();
+    let tr = run(&mut sup, &mut t, 1, u);
+    assert_eq!(tr[0].to, Mode::PreContact);
+    let mut prev = sup.arrangement().fusion_weight;
+    for _ in 0..steps {
+        t += DT;
+        let w = sup.update(t, &u).fusion_weight;
+        assert!(w <= prev + 1e-15);
+        prev = w;
+    }
+    assert_eq!(prev, f.w_precontact);
+    assert_eq!(sup.arrangement().sensing_range_m, p.sensing_range.nominal_m);
+}
+
+#[test]
+fn reversal_mid_shift_is_continuous() {
+    let p = phases_params();
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let u = SupervisorInput::default();
+    sup.request_phase(Phase::Contact).unwrap();
+    sup.update(0.0, &u);
+    let w_mid = sup.update(0.5, &u).fusion_weight;
+    sup.request_phase(Phase::PreContact).unwrap();
+    let w_after = sup.update(0.5, &u).fusion_weight;
+    assert_eq!(w_mid, w_after);
+}
+
+#[test]
+fn switching_does_not_reallocate_task_order() {
+    let p = params();
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let ptr = sup.arrangement().task_order().as_ptr();
+    let mut t = 0.0;
+    into_b(&mut sup, &mut t);
+    run(&mut sup, &mut t, 10, input(0.0, 3.0, 9.0, 0.2));
+    assert_eq!(sup.mode(), Mode::HardContact);
+    assert_eq!(sup.arrangement().task_order().as_ptr(), ptr);
+}
+
+#[test]
+fn log_ring_buffer_keeps_latest() {
+    let mut p = params();
+    p.log_capacity = 2;
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    into_b(&mut sup, &mut t); // a -> b
+    run(&mut sup, &mut t, 1, input(0.0, 3.0, 9.0, 0.2)); // b -> c
+    run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2)); // c -> b
+    assert_eq!(sup.log().total(), 3);
+    let kept: Vec<(Mode, Mode)> = sup.log().iter().map(|t| (t.from, t.to)).collect();
+    assert_eq!(
+        kept,
+        [
+            (Mode::IntentionalContact, Mode::HardContact),
+            (Mode::HardContact, Mode::IntentionalContact)
+        ]
+    );
+    assert_eq!(sup.log().last().unwrap().to, Mode::IntentionalContact);
+}
+
+// --- blending -------------------------------------------------------------------------------
+
+#[test]
+fn chi_starts_at_one_and_decreases_to_zero() {
+    let g = 10.0;
+    assert_eq!(chi(g, 0.0), 1.0);
+    assert_eq!(chi(g, -1.0), 1.0);
+    let mut prev = 1.0;
+    for k in 1..1000 {
+        let c = chi(g, k as f64 * 1e-3);
+        assert!(c <= prev && c >= 0.0);
+        prev = c;
+    }
+    assert!(chi(g, 5.0) < 1e-15);
+    // The paper's eq. (11) would start at 1/2: a step of half the torque gap.
+    let paper = (1.0 - (g * 0.0f64).tanh()) / 2.0;
+    assert_eq!(paper, 0.5);
+}
+
+#[test]
+fn blend_has_no_step_and_respects_per_cycle_bound() {
+    let n = 15;
+    let g = 10.0;
+    let dt = 0.008; // 125 Hz
+    let mut rng = Rng(7);
+    let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    for trial in 0..50 {
+        let mut blender = TorqueBlender::new(n);
+        let mut old = vec![0.0; n];
+        let mut new = vec![0.0; n];
+        for i in 0..n {
+            old[i] = 20.0 * rng.next();
+            new[i] = 20.0 * rng.next();
+        }
+        let mut out = vec![0.0; n];
+        let mut t = 0.0;
+        // Old arrangement's torque, then switch at t_t.
+        for _ in 0..5 {
+            t += dt;
+            blender.apply(t, &old, &mut out);
+        }
+        let before = out.clone();
+        blender.start(t + dt, g);
+        let mut prev = before.clone();
+        let mut tau_k = new.clone();
+        for step in 0..300 {
+            t += dt;
+            let prev_k = tau_k.clone();
+            // The new arrangement's torque keeps changing (random drift).
+            if step > 0 {
+                for x in tau_k.iter_mut() {
+                    *x += 0.5 * rng.next();
+                }
+            }
+            blender.apply(t, &tau_k, &mut out);
+            if step == 0 {
+                for i in 0..n {
+                    assert!(
+                        (out[i] - before[i]).abs() <= 1e-12,
+                        "step at switch, trial {trial}"
+                    );
+                }
+            } else {
+                let d: Vec<f64> = out.iter().zip(&prev).map(|(a, b)| a - b).collect();
+                let dk: Vec<f64> = tau_k.iter().zip(&prev_k).map(|(a, b)| a - b).collect();
+                let gap: Vec<f64> = before.iter().zip(&prev_k).map(|(a, b)| a - b).collect();
+                let bound = step_bound(g, dt, norm(&gap), norm(&dk));
+                assert!(
+                    norm(&d) <= bound * (1.0 + 1e-12) + 1e-12,
+                    "trial {trial} step {step}: {} > {bound}",
+                    norm(&d)
+                );
+            }
+            prev.copy_from_slice(&out);
+        }
+        assert!(!blender.is_blending());
+        assert_eq!(out, tau_k);
+    }
+}
+
+#[test]
+fn blend_syncs_with_arrangement_switch_time() {
+    let p = params();
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut blender = TorqueBlender::new(2);
+    let mut out = [0.0; 2];
+    let mut t = 0.0;
+    for _ in 0..300 {
+        t += DT;
+        let a = sup.update(t, &stuck());
+        blender.sync(a);
+        let tau = if a.mode == Mode::Avoidance {
+            [1.0, 2.0]
+        } else {
+            [-1.0, 0.0]
+        };
+        let last = out;
+        blender.apply(t, &tau, &mut out);
+        if sup.last_transition().is_some() {
+            assert_eq!(
+                out, last,
+                "first output after the switch is the held torque"
+            );
+            assert!(blender.is_blending());
+        }
+    }
+    assert_eq!(sup.log().total(), 1);
+}
+
+#[test]
+fn weight_shift_endpoints_and_monotonic() {
+    let s = WeightShift::new(0.2, 0.9, 1.0, 2.0, 10.0);
+    assert_eq!(s.at(0.0), 0.2);
+    assert_eq!(s.at(1.0), 0.2);
+    assert_eq!(s.at(3.0), 0.9);
+    assert_eq!(s.at(f64::NAN), 0.2);
+    let mut prev = 0.2;
+    for k in 0..=2000 {
+        let w = s.at(1.0 + k as f64 * 1e-3);
+        assert!(w >= prev - 1e-15);
+        prev = w;
+    }
+}
+
+// --- configuration errors -------------------------------------------------------------------
+
+fn shipped_text() -> String {
+    std::fs::read_to_string(shipped()).unwrap()
+}
+
+fn load_err(old: &str, new: &str) -> String {
+    let text = shipped_text();
+    let bad = text.replace(old, new);
+    assert_ne!(bad, text, "test expects `{old}` in the shipped file");
+    SupervisorParams::from_yaml_str(&bad, "bad.yaml")
+        .unwrap_err()
+        .to_string()
+}
+
+#[test]
+fn unknown_task_names_file_and_key() {
+    let e = load_err(
+        "[goal, contact_reaction, avoidance]",
+        "[goal, contact_reactoin, avoidance]",
+    );
+    assert!(
+        e.contains("bad.yaml")
+            && e.contains("arrangements.intentional_contact[1]")
+            && e.contains("contact_reactoin"),
+        "{e}"
+    );
+}
+
+#[test]
+fn duplicate_task_in_arrangement_is_rejected() {
+    let e = load_err(
+        "[goal, contact_reaction, avoidance]",
+        "[goal, goal, avoidance]",
+    );
+    assert!(
+        e.contains("bad.yaml")
+            && e.contains("arrangements.intentional_contact[1]")
+            && e.contains("duplicate"),
+        "{e}"
+    );
+}
+
+#[test]
+fn negative_eps_names_file_and_key() {
+    let e = load_err("speed_mps: 0.01 ", "speed_mps: -0.01 ");
+    assert!(
+        e.contains("bad.yaml") && e.contains("thresholds.speed_mps"),
+        "{e}"
+    );
+    let e = load_err("contact_force_n: 5.0", "contact_force_n: -5.0");
+    assert!(
+        e.contains("bad.yaml") && e.contains("thresholds.contact_force_n"),
+        "{e}"
+    );
+}
+
+#[test]
+fn hysteresis_larger_than_eps_c_is_rejected() {
+    for band in ["contact_band_n: 6.0", "contact_band_n: 5.0"] {
+        let e = load_err("contact_band_n: 1.5", band);
+        assert!(
+            e.contains("bad.yaml") && e.contains("thresholds.contact_band_n"),
+            "{e}"
+        );
+    }
+}
+
+#[test]
+fn other_invalid_values_are_rejected() {
+    for (old, new, key) in [
+        (
+            "intentional_contact_m: 0.0",
+            "intentional_contact_m: 0.5",
+            "sensing_range.intentional_contact_m",
+        ),
+        (
+            "smoothing_gain_per_s: 10.0",
+            "smoothing_gain_per_s: 0.0",
+            "smoothing_gain_per_s",
+        ),
+        ("w_contact: 1.0", "w_contact: 1.5", "fusion.w_contact"),
+        ("stuck_s: 0.5", "stuck_s: -0.5", "dwell.stuck_s"),
+        ("log_capacity: 64", "log_capacity: 0", "log_capacity"),
+    ] {
+        let e = load_err(old, new);
+        assert!(e.contains("bad.yaml") && e.contains(key), "{e}");
+    }
+}
+
+#[test]
+fn unknown_key_and_bad_policy_are_parse_errors() {
+    let e = load_err("log_capacity: 64", "log_capacity: 64\nlog_capacty: 3");
+    assert!(e.starts_with("bad.yaml:"), "{e}");
+    let e = load_err("policy: intentional_contact", "policy: intentional");
+    assert!(e.starts_with("bad.yaml:"), "{e}");
+}

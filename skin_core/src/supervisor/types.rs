@@ -1,0 +1,146 @@
+//! The supervisor's inputs and outputs, mirroring `skin_msgs/msg/Arrangement.msg`.
+
+use thiserror::Error;
+
+/// The active arrangement; the discriminants are the `MODE_*` constants of `Arrangement.msg`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Mode {
+    /// Paper 000 Table I (a): avoidance > goal > contact reaction (transitory phases).
+    Avoidance = 0,
+    /// Paper 000 Table I (b): goal > contact reaction > avoidance (intentional contact).
+    IntentionalContact = 1,
+    /// Paper 000 Table I (c): contact reaction > goal > avoidance (hard contact).
+    HardContact = 2,
+    /// Paper 003 Table 1, precontact phase.
+    PreContact = 3,
+    /// Paper 003 Table 1, contact phase.
+    Contact = 4,
+}
+
+impl Mode {
+    /// All modes, in discriminant order.
+    pub const ALL: [Mode; 5] = [
+        Mode::Avoidance,
+        Mode::IntentionalContact,
+        Mode::HardContact,
+        Mode::PreContact,
+        Mode::Contact,
+    ];
+
+    /// The `Arrangement.msg` mode constant.
+    pub fn as_u8(self) -> u8 {
+        self as u8
+    }
+
+    /// The mode for an `Arrangement.msg` constant, `None` when out of range.
+    pub fn from_u8(v: u8) -> Option<Mode> {
+        Mode::ALL.get(v as usize).copied()
+    }
+}
+
+/// A paper 003 phase that can be requested (paper 003 Sec. 4.2.2: the switch is manual).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Phase {
+    /// Approach: hand distance control > wrist > tactile guidance > avoidance, posture.
+    PreContact,
+    /// Contact: hand force control > wrist > position hold > avoidance, compliance, posture.
+    Contact,
+}
+
+impl Phase {
+    /// The mode of this phase.
+    pub fn mode(self) -> Mode {
+        match self {
+            Phase::PreContact => Mode::PreContact,
+            Phase::Contact => Mode::Contact,
+        }
+    }
+}
+
+/// A phase request that the supervisor refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+#[error("phase request refused: {reason}")]
+pub struct PhaseRefused {
+    /// Why.
+    pub reason: &'static str,
+}
+
+/// Sensed signals for one update, SI units. NaN is allowed and handled conservatively (see
+/// [`super::Supervisor::update`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SupervisorInput {
+    /// `‖ẋ‖` of the end effector [m/s].
+    pub ee_speed_mps: f64,
+    /// `‖F_d‖`, the largest skin repulsion force [N], computed with the NOMINAL sensing range
+    /// (otherwise shrinking the range in (b) would itself read as "nothing in range").
+    pub avoidance_force_n: f64,
+    /// `‖F_c‖`, the largest skin contact force [N].
+    pub contact_force_n: f64,
+    /// Distance of the end effector to its goal [m].
+    pub goal_error_m: f64,
+}
+
+/// Why a transition happened.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Cause {
+    /// Stopped near an obstacle with the goal not reached (paper 000 Table I (b) conditions).
+    Stuck,
+    /// Contact force at or above ε_c, or NaN (paper 000 Table I (c) condition).
+    ContactOverLimit,
+    /// Contact force back below ε_c − band for the dwell time.
+    ContactReleased,
+    /// Goal reached during intentional contact.
+    GoalReached,
+    /// No obstacle in the nominal range any more.
+    ObstacleCleared,
+    /// Speed, obstacle force or goal error NaN for the dwell time during intentional contact.
+    InvalidInput,
+    /// A paper 003 phase request.
+    PhaseRequest,
+}
+
+/// One arrangement switch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Transition {
+    /// The update time of the switch, `t_t` of paper 000 eq. (11) [s].
+    pub t_s: f64,
+    /// Mode before.
+    pub from: Mode,
+    /// Mode after.
+    pub to: Mode,
+    /// Why.
+    pub cause: Cause,
+}
+
+/// The active arrangement (the Rust side of `Arrangement.msg`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Arrangement {
+    /// The active mode.
+    pub mode: Mode,
+    /// Indices into the configured task-name list, highest priority first (capacity reserved
+    /// once, so switching does not allocate).
+    pub(super) task_order: Vec<usize>,
+    /// `t_t` of paper 000 eq. (11): time of the last switch [s].
+    pub switch_time_s: f64,
+    /// δ_t of paper 000 eq. (11) [1/s].
+    pub smoothing_gain_per_s: f64,
+    /// Current `d_range` of paper 000 eq. (3) [m] (ramps during (b) and back in (a)).
+    pub sensing_range_m: f64,
+    /// Current fusion weight `w` of paper 003 eq. (6) (follows the sigmoid after a phase switch).
+    pub fusion_weight: f64,
+    /// The value `fusion_weight` goes to (what `Arrangement.msg` carries as `fusion_weight`).
+    pub fusion_weight_target: f64,
+}
+
+impl Arrangement {
+    /// Task indices into the configured task-name list, highest priority first.
+    pub fn task_order(&self) -> &[usize] {
+        &self.task_order
+    }
+
+    /// Task names, highest priority first, given the configured list.
+    pub fn task_names<'a>(&'a self, tasks: &'a [String]) -> impl Iterator<Item = &'a str> + 'a {
+        self.task_order.iter().map(move |&i| tasks[i].as_str())
+    }
+}

@@ -52,7 +52,7 @@ def test_skin_cells_roundtrip_rclpy_r2r(spawn, rclpy_node):
     qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE,
                      history=HistoryPolicy.KEEP_LAST)
     relay = spawn(binary("skin_cells_relay"), "--input", "/interop/cells_in",
-                  "--output", "/interop/cells_out", "--count", N_MSGS)
+                  "--output", "/interop/cells_out")
     received = []
     rclpy_node.create_subscription(SkinCellArray, "/interop/cells_out", received.append, qos)
     pub = rclpy_node.create_publisher(SkinCellArray, "/interop/cells_in", qos)
@@ -67,4 +67,4 @@ def test_skin_cells_roundtrip_rclpy_r2r(spawn, rclpy_node):
                lambda: f"{N_MSGS} relayed messages (got {len(received)})")
     for s, g in zip(sent, received):
         assert_same(s, g)
-    assert relay.wait(timeout=10) == 0, relay.stdout.read()
+    assert relay.poll() is None, f"the relay exited: {relay.stdout.read()}"

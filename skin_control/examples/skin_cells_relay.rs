@@ -3,7 +3,9 @@
 //! node decodes and re-encodes every field, rclpy checks what comes back). It starts relaying
 //! once its output has a subscriber, so nothing is lost to discovery.
 //!
-//! `skin_cells_relay --input /skin/cells_in --output /skin/cells_out [--count N]`
+//! `skin_cells_relay --input /skin/cells_in --output /skin/cells_out` (runs until interrupted: an
+//! exit right after the last publish could drop samples that Fast DDS still sends
+//! asynchronously).
 use anyhow::Result;
 use clap::Parser;
 use futures::{executor::LocalPool, task::LocalSpawnExt, StreamExt};
@@ -19,9 +21,6 @@ struct Args {
     /// Topic to publish on.
     #[arg(long, default_value = "/skin/cells_out")]
     output: String,
-    /// Exit after relaying this many messages (0: run until interrupted).
-    #[arg(long, default_value_t = 0)]
-    count: usize,
 }
 
 fn main() -> Result<()> {
@@ -30,15 +29,13 @@ fn main() -> Result<()> {
     let mut node = r2r::Node::create(ctx, "skin_cells_relay", "")?;
     let mut sub = node.subscribe::<SkinCellArray>(&args.input, qos::stream())?;
     let publisher = node.create_publisher::<SkinCellArray>(&args.output, qos::stream())?;
-    let relayed = std::rc::Rc::new(std::cell::Cell::new(0usize));
     let mut pool = LocalPool::new();
-    let counter = relayed.clone();
     let output = args.output.clone();
     let matched = publisher.wait_for_inter_process_subscribers()?;
     pool.spawner().spawn_local(async move {
         // Discovery is not symmetric: a peer may already see our publisher while our writer has
         // not matched its reader yet, and a volatile writer drops what it sends before that. The
-        // input waits meanwhile in the reader's history (depth 10).
+        // input waits meanwhile in the subscription's queue (10 messages).
         if let Err(e) = matched.await {
             eprintln!("skin_cells_relay: waiting for a subscriber on {output} failed: {e}");
             return;
@@ -47,13 +44,11 @@ fn main() -> Result<()> {
             if let Err(e) = publisher.publish(&msg) {
                 eprintln!("skin_cells_relay: publish on {output} failed: {e}");
             }
-            counter.set(counter.get() + 1);
         }
     })?;
     println!("skin_cells_relay: {} -> {}", args.input, args.output);
-    while args.count == 0 || relayed.get() < args.count {
+    loop {
         node.spin_once(std::time::Duration::from_millis(10));
         pool.run_until_stalled();
     }
-    Ok(())
 }

@@ -267,13 +267,13 @@ impl Resolver {
         qd_measured: &[f64],
         dt_s: f64,
     ) -> Result<&Commands, ResolverError> {
-        let checked = self
-            .check_dt(dt_s)
-            .and_then(|_| self.check("tau", tau))
-            .and_then(|_| self.check("gravity", gravity))
-            .and_then(|_| self.check("q_measured", q_measured))
-            .and_then(|_| self.check("qd_measured", qd_measured));
-        if let Err(e) = checked {
+        let inputs = [
+            ("tau", tau),
+            ("gravity", gravity),
+            ("q_measured", q_measured),
+            ("qd_measured", qd_measured),
+        ];
+        if let Err(e) = self.check_inputs(dt_s, &inputs) {
             self.safe_stop_arms(dt_s);
             return Err(e);
         }
@@ -321,12 +321,12 @@ impl Resolver {
         qd_measured: &[f64],
         dt_s: f64,
     ) -> Result<&Commands, ResolverError> {
-        let checked = self
-            .check_dt(dt_s)
-            .and_then(|_| self.check("tau", tau))
-            .and_then(|_| self.check("q_measured", q_measured))
-            .and_then(|_| self.check("qd_measured", qd_measured));
-        if let Err(e) = checked {
+        let inputs = [
+            ("tau", tau),
+            ("q_measured", q_measured),
+            ("qd_measured", qd_measured),
+        ];
+        if let Err(e) = self.check_inputs(dt_s, &inputs) {
             self.safe_stop_base(dt_s);
             return Err(e);
         }
@@ -438,12 +438,16 @@ impl Resolver {
         }
     }
 
-    fn check_dt(&self, dt_s: f64) -> Result<(), ResolverError> {
-        if dt_s.is_finite() && dt_s > 0.0 {
-            Ok(())
-        } else {
-            Err(ResolverError::InvalidDt(dt_s))
+    /// The period, then each named model-order vector: length and finiteness.
+    fn check_inputs(
+        &self,
+        dt_s: f64,
+        inputs: &[(&'static str, &[f64])],
+    ) -> Result<(), ResolverError> {
+        if !(dt_s.is_finite() && dt_s > 0.0) {
+            return Err(ResolverError::InvalidDt(dt_s));
         }
+        inputs.iter().try_for_each(|&(what, x)| self.check(what, x))
     }
 
     fn check(&self, what: &'static str, x: &[f64]) -> Result<(), ResolverError> {

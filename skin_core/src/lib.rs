@@ -10,6 +10,8 @@
 //!   torque out, with damped, rank-aware inverses.
 //! - [`resolver`]: the admittance torque resolver (paper 003 eq. 26): torques to joint and base
 //!   velocity commands within the limits.
+//! - [`tasks`]: the tasks of both papers filling the hierarchy's levels (paper 000 eq. 3-9,
+//!   paper 003 eq. 4-18).
 //! - [`supervisor`]: which arrangement of tasks is active (paper 000 Table I, paper 003 Table 1)
 //!   and the smooth switch between them (paper 000 eq. 10-11).
 #![warn(missing_docs)]
@@ -19,3 +21,4 @@ pub mod model;
 pub mod resolver;
 pub mod skin;
 pub mod supervisor;
+pub mod tasks;

@@ -287,3 +287,91 @@ fn resolver_cycle_does_not_allocate_after_setup() {
         "heap allocations in the resolver cycle"
     );
 }
+
+#[test]
+fn tasks_do_not_allocate_after_setup() {
+    use nalgebra::{UnitQuaternion, Vector2};
+    use skin_core::tasks::avoidance::ProximityAvoidance;
+    use skin_core::tasks::base_avoidance::BaseAvoidance;
+    use skin_core::tasks::contact_reaction::ContactReaction;
+    use skin_core::tasks::goal::{GoalOrientation, GoalPosition};
+    use skin_core::tasks::hand_force::{HandForce, HandMeasurement};
+    use skin_core::tasks::params::TaskParams;
+    use skin_core::tasks::position_hold::PositionHold;
+    use skin_core::tasks::posture::Posture;
+    use skin_core::tasks::tactile_guidance::TactileGuidance;
+    use skin_core::tasks::wrist::CompliantWrist;
+
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let model = RobotModel::from_urdf_file(&root.join("urdf/tomm.urdf")).unwrap();
+    let layout = SkinLayout::load(&root.join("config/skin/tomm.yaml")).unwrap().resolve(&model).unwrap();
+    let skin = SkinParams::load(&root.join("config/skin_model.yaml")).unwrap();
+    let p = TaskParams::load(&root.join("config/tasks.yaml")).unwrap();
+    let nv = model.nv();
+    let n = layout.num_cells();
+    let hand = model.frame_index("right_hand").unwrap();
+    let joints = ["base_x_joint", "base_y_joint", "base_yaw_joint"].map(|j| model.joint_index(j).unwrap());
+    let mut data = ModelData::new(&model);
+    let q: Vec<f64> = (0..nv).map(|i| 0.2 * i as f64 - 0.4).collect();
+    let qd: Vec<f64> = (0..nv).map(|i| 0.01 * i as f64).collect();
+    let readings: Vec<CellReading> =
+        (0..n).map(|i| CellReading::uniform((i % 7) as f64 / 7.0, (i % 5) as f64 / 5.0)).collect();
+    let laser: Vec<Vector2<f64>> = (0..360)
+        .map(|k| {
+            let a = (k as f64).to_radians();
+            Vector2::new(a.cos(), a.sin()) * 0.6
+        })
+        .collect();
+
+    let mut goal = GoalPosition::new(nv, hand, Vector3::zeros(), p.goal);
+    let mut orient = GoalOrientation::new(nv, hand, p.goal_orientation);
+    let mut avoid = ProximityAvoidance::new(nv, p.avoidance);
+    let mut contact = ContactReaction::new(nv, p.contact_reaction);
+    let mut hand_task = HandForce::new(nv, hand, p.hand_force);
+    let mut wrist = CompliantWrist::new(nv, hand, p.wrist);
+    let mut guide = TactileGuidance::new(nv, hand, p.tactile_guidance);
+    let mut hold = PositionHold::new(nv, hand, Vector3::zeros(), p.position_hold);
+    let mut base = BaseAvoidance::new(nv, joints, p.base_avoidance).unwrap();
+    let mut posture = Posture::new(nv, &p.posture, &vec![0.0; nv]).unwrap();
+    let mut levels = [
+        TaskLevel::new("goal", nv, 3),
+        TaskLevel::new("orient", nv, 3),
+        TaskLevel::new("avoid", nv, n),
+        TaskLevel::new("contact", nv, n),
+        TaskLevel::new("hand", nv, 1),
+        TaskLevel::new("wrist", nv, 3),
+        TaskLevel::new("guide", nv, 3),
+        TaskLevel::new("hold", nv, 3),
+    ];
+    let mut wrenches: Vec<PatchWrench> = Vec::with_capacity(layout.patches().len());
+    let mut poses = Vec::with_capacity(layout.patches().len());
+    let goal_x = Vector3::new(0.5, -0.3, 1.0);
+    let goal_r = UnitQuaternion::identity();
+
+    let mut cycle = |data: &mut ModelData| {
+        update_kinematics(&model, data, &q, &qd).unwrap();
+        aggregate_patches(&layout, &readings, &skin.fusion, &mut wrenches).unwrap();
+        patch_poses_world(&layout, |f| data.frame_pose(f), &mut poses);
+        let h_f = sum_patch_forces_in_frame(data.frame_pose(hand), &poses, &wrenches, |j| j < 6);
+        let gamma = patch_wrench_world(&poses[5], &wrenches[5]).moment;
+        let [l0, l1, l2, l3, l4, l5, l6, l7] = &mut levels;
+        goal.update(&model, data, &goal_x, l0).unwrap();
+        orient.update(&model, data, &goal_r, l1).unwrap();
+        avoid.update(&model, data, &layout, &readings, &skin.proximity, 0.08, l2).unwrap();
+        contact.update(&model, data, &layout, &readings, &skin.force, &skin.fusion, l3).unwrap();
+        hand_task.update(&model, data, HandMeasurement::Force { fused_signal: 0.1 }, &skin.proximity, l4).unwrap();
+        wrist.update(&model, data, &gamma, l5).unwrap();
+        guide.update(&model, data, &h_f, l6).unwrap();
+        hold.update(&model, data, l7).unwrap();
+        base.update(&q, &laser).unwrap();
+        let tau = posture.update(&model, data, &layout, &wrenches, |j| j >= 6, Some(base.torque())).unwrap();
+        std::hint::black_box(tau);
+    };
+    cycle(&mut data); // first call may size the skin output vectors
+    let before = allocations();
+    for _ in 0..10 {
+        cycle(&mut data);
+    }
+    assert_eq!(allocations() - before, 0, "tasks allocated");
+    assert!(levels[2].rows() > 0 && levels[3].rows() > 0);
+}

@@ -1,0 +1,92 @@
+//! Paper 000 eq. (3)-(4): proximity avoidance as a force level, one directional row per cell.
+//!
+//! For every cell `i` whose proximity signal gives a distance `d_i < d_range` (inverse proximity
+//! characteristic), the row is `(−n_i)ᵀ J_v(p_i)` (world inward normal, cell position) and its
+//! force `F_di = K (d_range − d_i) ≥ 0`, so the level's torque is `Σ J_v(p_i)ᵀ (−n_i) F_di`
+//! (eq. 4): the link is pushed away from the obstacle, which is outside along `+n_i`.
+//! `d_range` is given per cycle: the supervisor shrinks it (0 disables the task).
+
+use nalgebra::Matrix6xX;
+
+use super::params::AvoidanceParams;
+use super::TaskError;
+use crate::hierarchy::{Reference, TaskLevel};
+use crate::model::{point_jacobian, ModelData, RobotModel};
+use crate::skin::aggregate::LengthMismatch;
+use crate::skin::characteristic::ProximityCharacteristic;
+use crate::skin::layout::ResolvedLayout;
+use crate::skin::repulsion::linear_repulsion;
+use crate::skin::signals::CellReading;
+
+/// Proximity avoidance over all cells of a layout.
+#[derive(Debug, Clone)]
+pub struct ProximityAvoidance {
+    /// `K` and the nominal `d_range`.
+    pub params: AvoidanceParams,
+    jac: Matrix6xX<f64>,
+}
+
+/// Summary of one avoidance update, for the supervisor.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct AvoidanceSummary {
+    /// Rows pushed (cells within range).
+    pub rows: usize,
+    /// `‖F_d‖`: Euclidean norm of the per-cell forces \[N\].
+    pub force_norm_n: f64,
+    /// Largest single `F_di` \[N\].
+    pub max_force_n: f64,
+    /// Smallest distance seen \[m\] (`f64::INFINITY` if none within range).
+    pub min_distance_m: f64,
+}
+
+impl ProximityAvoidance {
+    /// The task for a model with `nv` joints; its level needs `layout.num_cells()` rows.
+    pub fn new(nv: usize, params: AvoidanceParams) -> Self {
+        Self { params, jac: Matrix6xX::zeros(nv) }
+    }
+
+    /// Fills `level` (force rows) from `readings` (indexed like `layout.cells()`) with the sensing
+    /// range `range_m` of this cycle, capped by the characteristic's range.
+    #[allow(clippy::too_many_arguments)]
+    pub fn update(
+        &mut self,
+        model: &RobotModel,
+        data: &ModelData,
+        layout: &ResolvedLayout,
+        readings: &[CellReading],
+        proximity: &ProximityCharacteristic,
+        range_m: f64,
+        level: &mut TaskLevel,
+    ) -> Result<AvoidanceSummary, TaskError> {
+        LengthMismatch::check_readings(layout, readings)?;
+        level.clear();
+        let mut s = AvoidanceSummary { min_distance_m: f64::INFINITY, ..Default::default() };
+        let range = range_m.min(proximity.range_m);
+        if range.is_nan() || range <= 0.0 {
+            return Ok(s);
+        }
+        let prox = proximity.prepared();
+        let mut sum_sq = 0.0;
+        for (cell, reading) in layout.cells().iter().zip(readings) {
+            let p = reading.proximity_signal();
+            if p <= 0.0 {
+                continue;
+            }
+            let d = prox.distance_m(p);
+            if d >= range {
+                continue;
+            }
+            let f = linear_repulsion(self.params.gain_n_per_m, range, d);
+            let pose = data.frame_pose(cell.frame);
+            let inward = -(pose.rotation * cell.normal_link);
+            point_jacobian(model, data, cell.frame, &cell.position_link, &mut self.jac)?;
+            level.push_directional(inward.as_slice(), &self.jac.fixed_rows::<3>(0), Reference::Force { f: &[f] })?;
+            s.rows += 1;
+            sum_sq += f * f;
+            s.max_force_n = s.max_force_n.max(f);
+            s.min_distance_m = s.min_distance_m.min(d);
+        }
+        s.force_norm_n = sum_sq.sqrt();
+        Ok(s)
+    }
+}

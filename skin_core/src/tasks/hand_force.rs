@@ -1,0 +1,92 @@
+//! Paper 003 eq. (9), Table 1: hand force / distance control on one acceleration row.
+//!
+//! Frame `{h}`: the hand frame, its z axis along the palm's outward normal, i.e. into the surface
+//! to be touched. The row is the third row of the hand body Jacobian, `z_hᵀ J_v(o_h)` (world
+//! `z_h` from the frame pose), and
+//! `ẍ* = (K_1 Δ − D_1 ż_h) / Λ_1` (eq. 9) with
+//! - force mode (contact phase): `Δ = f_c,d − f_c` on the fused hand-patch signal `f_c`;
+//! - distance mode (approach phase): `Δ = d_p − d_p,d` with `d_p` from the proximity signal
+//!   through the inverse characteristic.
+//!
+//! Either way a positive `Δ` (too little force, too far away) accelerates the hand along `+z_h`,
+//! into the surface. The drift is `J̇q̇ = z_h·a_lin + (ω × z_h)·v`.
+
+use nalgebra::{Matrix6xX, Vector3, Vector6};
+
+use super::params::HandForceParams;
+use super::{rows_times_qd, TaskError};
+use crate::hierarchy::{Reference, TaskLevel};
+use crate::model::{point_jacobian, point_jacobian_dot_qdot, ModelData, RobotModel};
+use crate::skin::characteristic::ProximityCharacteristic;
+
+/// What the hand task regulates this cycle (paper 003 Table 1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum HandMeasurement {
+    /// Contact phase: the fused hand-patch signal `f_c` (z of the hand-frame patch force).
+    Force {
+        /// `f_c` in signal units \[0, 1\].
+        fused_signal: f64,
+    },
+    /// Approach phase: the hand's proximity signal (largest over the hand patch).
+    Distance {
+        /// Proximity signal \[0, 1\].
+        proximity_signal: f64,
+    },
+}
+
+/// Hand force/distance task.
+#[derive(Debug, Clone)]
+pub struct HandForce {
+    /// Hand frame `{h}` (z into the surface).
+    pub frame: usize,
+    /// Gains and set points.
+    pub params: HandForceParams,
+    jac: Matrix6xX<f64>,
+    drift: Vector6<f64>,
+}
+
+impl HandForce {
+    /// The task for `frame` on a model with `nv` joints; its level needs 1 row.
+    pub fn new(nv: usize, frame: usize, params: HandForceParams) -> Self {
+        Self { frame, params, jac: Matrix6xX::zeros(nv), drift: Vector6::zeros() }
+    }
+
+    /// The error `Δ` of eq. (9) for a measurement (positive: push along `+z_h`).
+    pub fn error(&self, measurement: HandMeasurement, proximity: &ProximityCharacteristic) -> f64 {
+        match measurement {
+            HandMeasurement::Force { fused_signal } => {
+                self.params.k_force_n_per_signal * (self.params.force_signal_desired - fused_signal)
+            }
+            HandMeasurement::Distance { proximity_signal } => {
+                self.params.k_distance_n_per_m * (proximity.distance_m(proximity_signal) - self.params.distance_desired_m)
+            }
+        }
+    }
+
+    /// Fills `level` (1 acceleration row); returns `ẍ*`.
+    pub fn update(
+        &mut self,
+        model: &RobotModel,
+        data: &ModelData,
+        measurement: HandMeasurement,
+        proximity: &ProximityCharacteristic,
+        level: &mut TaskLevel,
+    ) -> Result<f64, TaskError> {
+        let origin = Vector3::zeros();
+        point_jacobian(model, data, self.frame, &origin, &mut self.jac)?;
+        point_jacobian_dot_qdot(model, data, self.frame, &origin, &mut self.drift)?;
+        let z = data.frame_pose(self.frame).rotation * Vector3::z();
+        let v = rows_times_qd(&self.jac, 0, data.qd());
+        let w = rows_times_qd(&self.jac, 3, data.qd());
+        let a = Vector3::new(self.drift[0], self.drift[1], self.drift[2]);
+        let jdot_qdot = z.dot(&a) + w.cross(&z).dot(&v);
+        let xdd = (self.error(measurement, proximity) - self.params.d_n_s_per_m * z.dot(&v)) / self.params.lambda_kg;
+        level.clear();
+        level.push_directional(
+            z.as_slice(),
+            &self.jac.fixed_rows::<3>(0),
+            Reference::Acceleration { xdd_star: &[xdd], jdot_qdot: &[jdot_qdot] },
+        )?;
+        Ok(xdd)
+    }
+}

@@ -1,0 +1,84 @@
+//! The tasks of both papers: each fills a [`crate::hierarchy::TaskLevel`] (Jacobian rows and a
+//! reference) from the model data and the skin data, once per control cycle, without allocating
+//! (buffers are sized at construction). `docs/tasks.md` gives the equations as implemented and the
+//! sign conventions.
+//!
+//! | Task | Equation | Kind | Rows |
+//! |---|---|---|---|
+//! | [`goal::GoalPosition`] | paper 000 eq. (7)-(9) | force | 3 (linear, world) |
+//! | [`goal::GoalOrientation`] | paper 000 eq. (7)-(9) on `axis·angle(R_d Rᵀ)` | force | 3 (angular, world) |
+//! | [`avoidance::ProximityAvoidance`] | paper 000 eq. (3)-(4) | force | 1 per cell within `d_range` |
+//! | [`contact_reaction::ContactReaction`] | paper 000 eq. (6) | force | 1 per contact cell |
+//! | [`hand_force::HandForce`] | paper 003 eq. (9), Table 1 | acceleration | 1 (hand z) |
+//! | [`wrist::CompliantWrist`] | paper 003 eq. (10) | acceleration | 3 (angular, world) |
+//! | [`tactile_guidance::TactileGuidance`] | paper 003 eq. (11)-(12) | acceleration | 3 (linear, world) |
+//! | [`position_hold::PositionHold`] | paper 003 eq. (4), Table 1 | acceleration | 3 (linear, world) |
+//! | [`posture::Posture`] | paper 003 eq. (13)-(14), (18) | null-space torque | — |
+//! | [`base_avoidance::BaseAvoidance`] | paper 003 eq. (15)-(17) | torque (in `τ_s`) | — |
+//!
+//! Parameters: [`params::TaskParams`] (`config/tasks.yaml`).
+
+pub mod avoidance;
+pub mod base_avoidance;
+pub mod contact_reaction;
+pub mod goal;
+pub mod hand_force;
+pub mod params;
+pub mod position_hold;
+pub mod posture;
+pub mod tactile_guidance;
+pub mod wrist;
+
+#[cfg(test)]
+mod tests;
+
+use nalgebra::{Matrix6xX, Vector3};
+use thiserror::Error;
+
+use crate::hierarchy::HierarchyError;
+use crate::model::ModelError;
+use crate::skin::aggregate::LengthMismatch;
+
+/// Errors of a task update.
+#[derive(Debug, Error)]
+pub enum TaskError {
+    /// Kinematics query failed (bad frame, non-finite point, wrong size).
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The level rejected the rows (too many rows, wrong sizes).
+    #[error(transparent)]
+    Level(#[from] HierarchyError),
+    /// Skin readings do not match the layout.
+    #[error(transparent)]
+    Skin(#[from] LengthMismatch),
+    /// A per-cycle input has the wrong length.
+    #[error("{what}: expected length {expected}, got {got}")]
+    Length {
+        /// What was wrong.
+        what: &'static str,
+        /// Expected length.
+        expected: usize,
+        /// Given length.
+        got: usize,
+    },
+}
+
+/// `J[row0..row0+3] q̇` of a 6 × nv Jacobian (linear rows: 0, angular rows: 3), no allocation.
+pub(crate) fn rows_times_qd(jac: &Matrix6xX<f64>, row0: usize, qd: &[f64]) -> Vector3<f64> {
+    let mut v = Vector3::zeros();
+    for (c, q) in qd.iter().enumerate().take(jac.ncols()) {
+        for r in 0..3 {
+            v[r] += jac[(row0 + r, c)] * q;
+        }
+    }
+    v
+}
+
+/// Reference acceleration of paper 003 eq. (4)/(5) per axis: `(k e − d ẋ) / λ`.
+pub(crate) fn impedance_acceleration(
+    imp: &params::Impedance3,
+    error: &Vector3<f64>,
+    velocity: &Vector3<f64>,
+) -> Vector3<f64> {
+    Vector3::from_fn(|i, _| (imp.k[i] * error[i] - imp.d[i] * velocity[i]) / imp.lambda[i])
+}

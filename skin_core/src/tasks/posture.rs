@@ -1,0 +1,84 @@
+//! Paper 003 eq. (18): joint compliance and posture, the torque projected into the null space of
+//! all levels: `τ_c* = −K_c (q − q_post) − D_c q̇ − τ_s` with
+//! `τ_s = k_skin τ_skin + τ_oca`: the body skin torque of eq. (13)-(14) (patch virtual wrenches,
+//! outward, so `−τ_skin` yields to the touch) and the base avoidance torque of eq. (15)-(17)
+//! ([`super::base_avoidance`], toward the obstacles, so `−τ_oca` moves away).
+
+use nalgebra::DVector;
+
+use super::params::PostureParams;
+use super::TaskError;
+use crate::model::{ModelData, RobotModel};
+use crate::skin::aggregate::PatchWrench;
+use crate::skin::layout::ResolvedLayout;
+use crate::skin::torques::patch_wrenches_to_torques;
+
+/// Joint compliance / posture torque.
+#[derive(Debug, Clone)]
+pub struct Posture {
+    /// `K_c` diagonal.
+    pub k_c: DVector<f64>,
+    /// `D_c` diagonal.
+    pub d_c: DVector<f64>,
+    /// Gain on `τ_skin`.
+    pub skin_gain: f64,
+    /// Desired posture `q_post`.
+    pub q_post: DVector<f64>,
+    tau_skin: DVector<f64>,
+    tau: DVector<f64>,
+}
+
+fn expand(v: &[f64], nv: usize, what: &'static str) -> Result<DVector<f64>, TaskError> {
+    match v.len() {
+        1 => Ok(DVector::from_element(nv, v[0])),
+        n if n == nv => Ok(DVector::from_column_slice(v)),
+        n => Err(TaskError::Length { what, expected: nv, got: n }),
+    }
+}
+
+impl Posture {
+    /// The posture task for `nv` joints (gains of length 1 or nv) with the desired posture `q_post`.
+    pub fn new(nv: usize, params: &PostureParams, q_post: &[f64]) -> Result<Self, TaskError> {
+        Ok(Self {
+            k_c: expand(&params.k_c, nv, "posture.k_c")?,
+            d_c: expand(&params.d_c, nv, "posture.d_c")?,
+            skin_gain: params.skin_gain,
+            q_post: expand(q_post, nv, "q_post")?,
+            tau_skin: DVector::zeros(nv),
+            tau: DVector::zeros(nv),
+        })
+    }
+
+    /// Computes `τ_c*` at the state of the last `update_kinematics` from the patch wrenches of the
+    /// body patches selected by `include` and the optional `τ_oca`; returns it (pass
+    /// `Some(posture.update(..)?.as_slice())` to the solver).
+    pub fn update(
+        &mut self,
+        model: &RobotModel,
+        data: &ModelData,
+        layout: &ResolvedLayout,
+        wrenches: &[PatchWrench],
+        include: impl Fn(usize) -> bool,
+        tau_oca: Option<&DVector<f64>>,
+    ) -> Result<&DVector<f64>, TaskError> {
+        let nv = self.tau.len();
+        if data.q().len() != nv {
+            return Err(TaskError::Length { what: "model nv", expected: nv, got: data.q().len() });
+        }
+        if wrenches.len() < layout.patches().len() {
+            return Err(TaskError::Length { what: "patch wrenches", expected: layout.patches().len(), got: wrenches.len() });
+        }
+        patch_wrenches_to_torques(model, data, layout, wrenches, include, &mut self.tau_skin);
+        let (q, qd) = (data.q(), data.qd());
+        for i in 0..nv {
+            let oca = tau_oca.map_or(0.0, |t| t[i]);
+            self.tau[i] = -self.k_c[i] * (q[i] - self.q_post[i]) - self.d_c[i] * qd[i] - (self.skin_gain * self.tau_skin[i] + oca);
+        }
+        Ok(&self.tau)
+    }
+
+    /// `τ_c*` of the last update.
+    pub fn torque(&self) -> &DVector<f64> {
+        &self.tau
+    }
+}

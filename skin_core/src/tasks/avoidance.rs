@@ -9,9 +9,10 @@
 use nalgebra::Matrix6xX;
 
 use super::params::AvoidanceParams;
+use super::point_rows::push_inward_cell_row;
 use super::TaskError;
-use crate::hierarchy::{Reference, TaskLevel};
-use crate::model::{point_jacobian, ModelData, RobotModel};
+use crate::hierarchy::TaskLevel;
+use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::LengthMismatch;
 use crate::skin::characteristic::ProximityCharacteristic;
 use crate::skin::layout::ResolvedLayout;
@@ -77,10 +78,7 @@ impl ProximityAvoidance {
                 continue;
             }
             let f = linear_repulsion(self.params.gain_n_per_m, range, d);
-            let pose = data.frame_pose(cell.frame);
-            let inward = -(pose.rotation * cell.normal_link);
-            point_jacobian(model, data, cell.frame, &cell.position_link, &mut self.jac)?;
-            level.push_directional(inward.as_slice(), &self.jac.fixed_rows::<3>(0), Reference::Force { f: &[f] })?;
+            push_inward_cell_row(model, data, cell, f, &mut self.jac, level)?;
             s.rows += 1;
             sum_sq += f * f;
             s.max_force_n = s.max_force_n.max(f);

@@ -10,9 +10,10 @@
 use nalgebra::Matrix6xX;
 
 use super::params::ContactReactionParams;
+use super::point_rows::push_inward_cell_row;
 use super::TaskError;
-use crate::hierarchy::{Reference, TaskLevel};
-use crate::model::{point_jacobian, ModelData, RobotModel};
+use crate::hierarchy::TaskLevel;
+use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::{FusionParams, LengthMismatch};
 use crate::skin::characteristic::ForceCharacteristic;
 use crate::skin::layout::ResolvedLayout;
@@ -66,9 +67,7 @@ impl ContactReaction {
             }
             let measured = force.force_n(sig);
             let f = (self.params.gain * measured).min(self.params.max_force_n);
-            let inward = -(data.frame_pose(cell.frame).rotation * cell.normal_link);
-            point_jacobian(model, data, cell.frame, &cell.position_link, &mut self.jac)?;
-            level.push_directional(inward.as_slice(), &self.jac.fixed_rows::<3>(0), Reference::Force { f: &[f] })?;
+            push_inward_cell_row(model, data, cell, f, &mut self.jac, level)?;
             s.rows += 1;
             s.max_force_n = s.max_force_n.max(f);
             s.max_measured_n = s.max_measured_n.max(measured);

@@ -11,12 +11,13 @@
 //! Either way a positive `Δ` (too little force, too far away) accelerates the hand along `+z_h`,
 //! into the surface. The drift is `J̇q̇ = z_h·a_lin + (ω × z_h)·v`.
 
-use nalgebra::{Matrix6xX, Vector3, Vector6};
+use nalgebra::Vector3;
 
 use super::params::HandForceParams;
-use super::{rows_times_qd, TaskError};
+use super::point_rows::{PointRows, ANGULAR, LINEAR};
+use super::TaskError;
 use crate::hierarchy::{Reference, TaskLevel};
-use crate::model::{point_jacobian, point_jacobian_dot_qdot, ModelData, RobotModel};
+use crate::model::{ModelData, RobotModel};
 use crate::skin::characteristic::ProximityCharacteristic;
 
 /// What the hand task regulates this cycle (paper 003 Table 1).
@@ -41,14 +42,13 @@ pub struct HandForce {
     pub frame: usize,
     /// Gains and set points.
     pub params: HandForceParams,
-    jac: Matrix6xX<f64>,
-    drift: Vector6<f64>,
+    rows: PointRows,
 }
 
 impl HandForce {
     /// The task for `frame` on a model with `nv` joints; its level needs 1 row.
     pub fn new(nv: usize, frame: usize, params: HandForceParams) -> Self {
-        Self { frame, params, jac: Matrix6xX::zeros(nv), drift: Vector6::zeros() }
+        Self { frame, params, rows: PointRows::new(nv) }
     }
 
     /// The error `Δ` of eq. (9) for a measurement (positive: push along `+z_h`).
@@ -72,19 +72,17 @@ impl HandForce {
         proximity: &ProximityCharacteristic,
         level: &mut TaskLevel,
     ) -> Result<f64, TaskError> {
-        let origin = Vector3::zeros();
-        point_jacobian(model, data, self.frame, &origin, &mut self.jac)?;
-        point_jacobian_dot_qdot(model, data, self.frame, &origin, &mut self.drift)?;
+        self.rows.update(model, data, self.frame, &Vector3::zeros())?;
         let z = data.frame_pose(self.frame).rotation * Vector3::z();
-        let v = rows_times_qd(&self.jac, 0, data.qd());
-        let w = rows_times_qd(&self.jac, 3, data.qd());
-        let a = Vector3::new(self.drift[0], self.drift[1], self.drift[2]);
+        let v = self.rows.velocity(LINEAR, data.qd());
+        let w = self.rows.velocity(ANGULAR, data.qd());
+        let a = self.rows.drift(LINEAR);
         let jdot_qdot = z.dot(&a) + w.cross(&z).dot(&v);
         let xdd = (self.error(measurement, proximity) - self.params.d_n_s_per_m * z.dot(&v)) / self.params.lambda_kg;
         level.clear();
         level.push_directional(
             z.as_slice(),
-            &self.jac.fixed_rows::<3>(0),
+            &self.rows.jac.fixed_rows::<3>(LINEAR),
             Reference::Acceleration { xdd_star: &[xdd], jdot_qdot: &[jdot_qdot] },
         )?;
         Ok(xdd)

@@ -24,6 +24,7 @@ pub mod contact_reaction;
 pub mod goal;
 pub mod hand_force;
 pub mod params;
+mod point_rows;
 pub mod position_hold;
 pub mod posture;
 pub mod tactile_guidance;

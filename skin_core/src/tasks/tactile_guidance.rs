@@ -6,12 +6,13 @@
 //! outward virtual forces: a push on the forearm ALONG `d` activates cells whose outward normal
 //! is `−d`, so `ʰF_arm ∥ −d` and `−K ʰF_arm ∥ d`: the hand follows the push.
 
-use nalgebra::{Matrix6xX, Vector3, Vector6};
+use nalgebra::Vector3;
 
 use super::params::Impedance3;
-use super::{impedance_acceleration, rows_times_qd, TaskError};
-use crate::hierarchy::{Reference, TaskLevel};
-use crate::model::{point_jacobian, point_jacobian_dot_qdot, ModelData, RobotModel};
+use super::point_rows::{PointRows, LINEAR};
+use super::{impedance_acceleration, TaskError};
+use crate::hierarchy::TaskLevel;
+use crate::model::{ModelData, RobotModel};
 
 /// Tactile guidance task.
 #[derive(Debug, Clone)]
@@ -20,14 +21,13 @@ pub struct TactileGuidance {
     pub frame: usize,
     /// `Λ`, `K`, `D` diagonals in `{h}`.
     pub params: Impedance3,
-    jac: Matrix6xX<f64>,
-    drift: Vector6<f64>,
+    rows: PointRows,
 }
 
 impl TactileGuidance {
     /// The task for `frame` on a model with `nv` joints; its level needs 3 rows.
     pub fn new(nv: usize, frame: usize, params: Impedance3) -> Self {
-        Self { frame, params, jac: Matrix6xX::zeros(nv), drift: Vector6::zeros() }
+        Self { frame, params, rows: PointRows::new(nv) }
     }
 
     /// Fills `level` (3 acceleration rows) for the arm force `arm_force_hand` (`ʰF_arm`, eq. 11);
@@ -39,17 +39,11 @@ impl TactileGuidance {
         arm_force_hand: &Vector3<f64>,
         level: &mut TaskLevel,
     ) -> Result<Vector3<f64>, TaskError> {
-        let origin = Vector3::zeros();
-        point_jacobian(model, data, self.frame, &origin, &mut self.jac)?;
-        point_jacobian_dot_qdot(model, data, self.frame, &origin, &mut self.drift)?;
+        self.rows.update(model, data, self.frame, &Vector3::zeros())?;
         let r = data.frame_pose(self.frame).rotation;
-        let v_h = r.inverse_transform_vector(&rows_times_qd(&self.jac, 0, data.qd()));
+        let v_h = r.inverse_transform_vector(&self.rows.velocity(LINEAR, data.qd()));
         let xdd = r * impedance_acceleration(&self.params, &(-arm_force_hand), &v_h);
-        let drift = Vector3::new(self.drift[0], self.drift[1], self.drift[2]);
-        level.set(
-            &self.jac.fixed_rows::<3>(0),
-            Reference::Acceleration { xdd_star: xdd.as_slice(), jdot_qdot: drift.as_slice() },
-        )?;
+        self.rows.set_acceleration(level, LINEAR, &xdd)?;
         Ok(xdd)
     }
 }

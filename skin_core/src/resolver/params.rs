@@ -7,8 +7,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::skin::params::{InvalidParam, ParamsError};
-use crate::skin::yaml;
+use crate::skin::params::{load_validated, parse_validated, InvalidParam, ParamsError};
 
 /// All resolver parameters (one YAML file, sections as the fields).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -178,18 +177,12 @@ impl ResolverParams {
 
     /// Parses and validates YAML text; `source` names the file in errors.
     pub fn from_yaml_str(text: &str, source: &str) -> Result<Self, ParamsError> {
-        let p: ResolverParams = yaml::parse_str(text, source)?;
-        p.validate().map_err(|param| ParamsError::Invalid {
-            file: source.to_string(),
-            param,
-        })?;
-        Ok(p)
+        parse_validated(text, source, Self::validate)
     }
 
     /// Reads, parses and validates the file at `path`.
     pub fn load(path: &Path) -> Result<Self, ParamsError> {
-        let (text, file) = yaml::read_text(path)?;
-        Self::from_yaml_str(&text, &file)
+        load_validated(path, Self::validate)
     }
 }
 

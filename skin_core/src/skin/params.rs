@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -58,7 +59,7 @@ impl InvalidParam {
     }
 }
 
-/// Errors loading a skin parameter file.
+/// Errors loading a parameter file (skin model, resolver, tasks).
 #[derive(Debug, Error)]
 pub enum ParamsError {
     /// Unreadable or unparsable file.
@@ -72,6 +73,26 @@ pub enum ParamsError {
         /// The parameter and why it is invalid.
         param: InvalidParam,
     },
+}
+
+/// Parses YAML `text` as `T` and checks it with `validate`; `source` names the file in errors.
+pub fn parse_validated<T: DeserializeOwned>(
+    text: &str,
+    source: &str,
+    validate: impl FnOnce(&T) -> Result<(), InvalidParam>,
+) -> Result<T, ParamsError> {
+    let p: T = yaml::parse_str(text, source)?;
+    validate(&p).map_err(|param| ParamsError::Invalid { file: source.to_string(), param })?;
+    Ok(p)
+}
+
+/// Reads the file at `path`, then [`parse_validated`].
+pub fn load_validated<T: DeserializeOwned>(
+    path: &Path,
+    validate: impl FnOnce(&T) -> Result<(), InvalidParam>,
+) -> Result<T, ParamsError> {
+    let (text, file) = yaml::read_text(path)?;
+    parse_validated(&text, &file, validate)
 }
 
 /// All skin model parameters (one YAML file, sections as the fields).
@@ -107,18 +128,12 @@ impl SkinParams {
 
     /// Parses and validates YAML text; `source` names the file in errors.
     pub fn from_yaml_str(text: &str, source: &str) -> Result<Self, ParamsError> {
-        let p: SkinParams = yaml::parse_str(text, source)?;
-        p.validate().map_err(|param| ParamsError::Invalid {
-            file: source.to_string(),
-            param,
-        })?;
-        Ok(p)
+        parse_validated(text, source, Self::validate)
     }
 
     /// Reads, parses and validates the file at `path`.
     pub fn load(path: &Path) -> Result<Self, ParamsError> {
-        let (text, file) = yaml::read_text(path)?;
-        Self::from_yaml_str(&text, &file)
+        load_validated(path, Self::validate)
     }
 }
 

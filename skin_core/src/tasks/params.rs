@@ -4,10 +4,8 @@
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
-use thiserror::Error;
 
-use crate::skin::params::InvalidParam;
-use crate::skin::yaml::{self, YamlError};
+use crate::skin::params::{load_validated, parse_validated, InvalidParam, ParamsError};
 
 /// Paper 000 eq. (7)-(9): goal task gains and speed limit (used for position and orientation).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -127,22 +125,6 @@ pub struct TaskParams {
     pub posture: PostureParams,
 }
 
-/// Errors loading a task parameter file.
-#[derive(Debug, Error)]
-pub enum TaskParamsError {
-    /// Unreadable or unparsable file.
-    #[error(transparent)]
-    Yaml(#[from] YamlError),
-    /// A value out of its valid range.
-    #[error("{file}: {param}")]
-    Invalid {
-        /// The file.
-        file: String,
-        /// The parameter.
-        param: InvalidParam,
-    },
-}
-
 fn pos(prefix: &str, name: &str, v: f64) -> Result<(), InvalidParam> {
     InvalidParam::positive_finite(prefix, name, v)
 }
@@ -212,15 +194,12 @@ impl TaskParams {
     }
 
     /// Parses and validates `text`; `source` names the file in errors.
-    pub fn from_yaml_str(text: &str, source: &str) -> Result<Self, TaskParamsError> {
-        let p: TaskParams = yaml::parse_str(text, source)?;
-        p.validate().map_err(|param| TaskParamsError::Invalid { file: source.to_string(), param })?;
-        Ok(p)
+    pub fn from_yaml_str(text: &str, source: &str) -> Result<Self, ParamsError> {
+        parse_validated(text, source, Self::validate)
     }
 
     /// Loads and validates the file at `path`.
-    pub fn load(path: &Path) -> Result<Self, TaskParamsError> {
-        let (text, file) = yaml::read_text(path)?;
-        Self::from_yaml_str(&text, &file)
+    pub fn load(path: &Path) -> Result<Self, ParamsError> {
+        load_validated(path, Self::validate)
     }
 }

@@ -10,7 +10,8 @@ use super::base_avoidance::BaseAvoidance;
 use super::contact_reaction::ContactReaction;
 use super::goal::{saturated_goal_force, GoalOrientation, GoalPosition};
 use super::hand_force::{HandForce, HandMeasurement};
-use super::params::{TaskParams, TaskParamsError};
+use super::params::TaskParams;
+use crate::skin::params::ParamsError;
 use super::position_hold::PositionHold;
 use super::posture::Posture;
 use super::tactile_guidance::TactileGuidance;
@@ -73,7 +74,7 @@ fn shipped_params_load_and_errors_name_file_and_key() {
     let text = std::fs::read_to_string(root().join("config/tasks.yaml")).unwrap();
     let bad = text.replace("alpha_m: 0.15", "alpha_m: -1.0");
     let e = TaskParams::from_yaml_str(&bad, "t.yaml").unwrap_err();
-    assert!(matches!(e, TaskParamsError::Invalid { .. }));
+    assert!(matches!(e, ParamsError::Invalid { .. }));
     let msg = e.to_string();
     assert!(msg.contains("t.yaml") && msg.contains("base_avoidance.alpha_m"), "{msg}");
     let unknown = text.replace("gain: 1.0", "gain: 1.0\n  extra: 2.0");

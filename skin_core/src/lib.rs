@@ -1,6 +1,8 @@
 //! `skin_core`: the control law of skin_control, written once and used unchanged by the
 //! simulation loop, the ROS 2 nodes and the benchmarks. Pure Rust: no ROS, no MuJoCo.
 //!
+//! - [`controller`]: the whole cycle behind one [`controller::Controller::update`]: measurements in,
+//!   joint and base velocity commands out.
 //! - [`model`]: the immutable [`model::RobotModel`] built from a URDF and the preallocated
 //!   [`model::ModelData`] workspace that kinematics and dynamics (CRBA, RNEA) fill.
 //! - [`skin`]: skin layouts, the cells' signal characteristics and the aggregation of cells into
@@ -16,6 +18,7 @@
 //!   and the smooth switch between them (paper 000 eq. 10-11).
 #![warn(missing_docs)]
 
+pub mod controller;
 pub mod hierarchy;
 pub mod model;
 pub mod resolver;

@@ -7,6 +7,7 @@
 use nalgebra::{DMatrix, DVector, Matrix6xX, SymmetricEigen, Vector3, Vector6};
 use skin_core::hierarchy::*;
 use skin_core::model::*;
+use proptest::prelude::*;
 
 fn load(file: &str) -> RobotModel {
     let path = format!("{}/../urdf/{file}", env!("CARGO_MANIFEST_DIR"));
@@ -63,7 +64,7 @@ fn acc_level(name: &str, j: &DMatrix<f64>, jd: &DVector<f64>, xdd: &[f64]) -> Ta
 }
 
 fn solve(s: &State, levels: &[&TaskLevel], posture: Option<&[f64]>) -> (DVector<f64>, Vec<LevelDiagnostics>) {
-    let mut solver = HierarchySolver::new(s.n(), 8, 16, InverseParams::default()).unwrap();
+    let mut solver = HierarchySolver::new(s.n(), 8, 100, InverseParams::default()).unwrap();
     let mut tau = DVector::zeros(s.n());
     solver.solve(&s.m, levels.iter().copied(), posture, None, &mut tau).unwrap();
     (tau, solver.diagnostics().to_vec())
@@ -439,4 +440,144 @@ fn hierarchy_solve_model_matches_solve() {
     assert!((&a - &b).amax() < 1e-12);
     solver.solve_model(&model, &mut data, [&level], Some(&posture), false, &mut b).unwrap();
     assert!((&a - &b - &bias).amax() < 1e-12);
+}
+
+/// Paper 003 eq. (19)-(25) written literally with nalgebra (m × m inverses by `SymmetricEigen`
+/// and the same eigenvalue filter): the reference for the solver's fast paths.
+fn reference_solve(m: &DMatrix<f64>, levels: &[(DMatrix<f64>, DVector<f64>, bool)], p: &InverseParams) -> DVector<f64> {
+    let n = m.nrows();
+    let minv = m.clone().try_inverse().unwrap();
+    let mut nproj = DMatrix::<f64>::identity(n, n);
+    let mut tau = DVector::zeros(n);
+    for (j, x, is_force) in levels {
+        let jb = j * nproj.transpose();
+        let a = &jb * &minv * jb.transpose();
+        let a = (&a + a.transpose()) * 0.5;
+        let eig = SymmetricEigen::new(a);
+        let thr = p.threshold(eig.eigenvalues.max());
+        let f = DMatrix::from_diagonal(&eig.eigenvalues.map(|e| p.filter(e, thr)));
+        let lam = &eig.eigenvectors * f * eig.eigenvectors.transpose();
+        let s = if *is_force { x.clone() } else { &lam * (x - j * &minv * &tau) };
+        tau += jb.transpose() * s;
+        nproj = &nproj * (DMatrix::identity(n, n) - jb.transpose() * &lam * &jb * &minv);
+    }
+    tau
+}
+
+/// A level with more rows than joints (50 stacked cell rows of rank 1, then 40 random rows)
+/// takes the joint-space path; it must equal the literal m × m formulation, for force and
+/// acceleration references, below a narrow level, and stay within the torque bound for 1e6 N.
+#[test]
+fn hierarchy_wide_levels_match_the_literal_formulation() {
+    let model = load("tomm.urdf");
+    let (q, qd) = tomm_q(model.nv());
+    let s = State::new("tomm.urdf", &q, &qd);
+    let n = s.n();
+    let (j1, jd1) = s.task("right_hand", [0.0; 3], &[0, 1, 2]);
+    let x1 = [0.3, -0.2, 0.1];
+    let l1 = acc_level("hand", &j1, &jd1, &x1);
+    let (jc, _) = s.task("right_forearm_link", [-0.1, 0.05, 0.02], &[0, 1, 2]);
+    let row = jc.row(1).into_owned();
+    let mut rng = 7u64;
+    let mut rand = move || {
+        rng = rng.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((rng >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    };
+    for (force, rows, scale) in [(true, 50, 1e6), (true, 90, 5.0), (false, 90, 1.0)] {
+        let mut j2 = DMatrix::zeros(rows, n);
+        for r in 0..rows {
+            if r < 50 {
+                j2.set_row(r, &row); // rank 1: the same cell row 50 times
+            } else {
+                j2.set_row(r, &DMatrix::from_fn(1, n, |_, _| rand()).row(0));
+            }
+        }
+        let x2 = DVector::from_fn(rows, |_, _| scale * (0.5 + rand()));
+        let mut l2 = TaskLevel::new("cells", n, rows);
+        let reference = if force { Reference::Force { f: x2.as_slice() } } else { Reference::Acceleration { xdd_star: x2.as_slice(), jdot_qdot: &vec![0.0; rows] } };
+        l2.set(&j2, reference).unwrap();
+        let (tau, diag) = solve(&s, &[&l1, &l2], None);
+        assert!(tau.iter().all(|t| t.is_finite()));
+        let x1v = DVector::from_column_slice(&x1) - &jd1;
+        let want = reference_solve(&s.m, &[(j1.clone(), x1v, false), (j2.clone(), x2.clone(), force)], &InverseParams::default());
+        let err = (&tau - &want).amax() / want.amax().max(1.0);
+        assert!(err < 1e-8, "rows {rows}, force {force}: relative difference {err:e}");
+        if rows == 50 {
+            assert_eq!(diag[1].rank, 1, "50 copies of one row have rank 1");
+        }
+    }
+}
+
+/// Levels of the strict-priority property: (link, point, Jacobian rows) per level.
+const P7_LEVELS: [(&str, [f64; 3], &[usize]); 3] =
+    [("ee", [0.0; 3], &[0, 1]), ("link4", [0.1, 0.0, 0.0], &[0, 1]), ("link2", [0.2, 0.0, 0.0], &[1])];
+const TOMM_LEVELS: [(&str, [f64; 3], &[usize]); 4] = [
+    ("right_hand", [0.0; 3], &[3, 4, 5]),
+    ("right_hand", [0.0; 3], &[0, 1, 2]),
+    ("left_hand", [0.0; 3], &[0, 1, 2]),
+    ("right_forearm_link", [-0.2, 0.0, 0.05], &[2]),
+];
+
+/// Strict priority (paper 003 eq. 19-25): the acceleration `J_i q̈ + J̇_i q̇` level `i` gets is the
+/// same (to 1e-9 relative to the round-off scale below) whether the levels below it (and the posture) are there or not. Random non-singular
+/// states (states where a level loses rank or enters the damping band are skipped: there the
+/// hierarchy deliberately trades accuracy for boundedness) and random references.
+fn strict_priority_case(file: &str, spec: &[(&str, [f64; 3], &[usize])], u: &[f64], refs: &[f64]) -> Result<(), TestCaseError> {
+    let model = load(file);
+    let n = model.nv();
+    let q: Vec<f64> = model.joint_limits().iter().zip(u).map(|(l, u)| {
+        let (lo, hi) = (l.lower.max(-3.1), l.upper.min(3.1));
+        lo + u * (hi - lo)
+    }).collect();
+    let qd: Vec<f64> = u[n..2 * n].iter().map(|v| v - 0.5).collect();
+    let s = State::new(file, &q, &qd);
+    let mut levels = Vec::new();
+    let mut tasks = Vec::new();
+    let mut r = refs.iter();
+    for (k, (link, p, rows)) in spec.iter().enumerate() {
+        let (j, jd) = s.task(link, *p, rows);
+        let x: Vec<f64> = rows.iter().map(|_| 4.0 * r.next().unwrap()).collect();
+        levels.push(acc_level(&format!("level{k}"), &j, &jd, &x));
+        tasks.push((j, jd));
+    }
+    let posture: Vec<f64> = (0..n).map(|_| 20.0 * r.next().unwrap()).collect();
+    let refs: Vec<&TaskLevel> = levels.iter().collect();
+    let (full, diag) = solve(&s, &refs, Some(&posture));
+    // proptest counts the skipped states and fails if they exceed its reject limit
+    prop_assume!(diag.iter().all(|d| d.damped == 0 && d.rank == d.rows));
+    let qdd_full = s.qdd(&full);
+    for i in 0..levels.len() {
+        let (upper, _) = solve(&s, &refs[..=i], None);
+        let qdd_upper = s.qdd(&upper);
+        let (j, _) = &tasks[i];
+        let diff = (j * (&qdd_full - &qdd_upper)).amax();
+        // Round-off scale: the acceleration the lower levels' torque Δτ could give level i
+        // without the projection, ‖J_i M⁻¹‖ ‖Δτ‖ (large for TOMM's light wrists: M⁻¹ ~ 1e4),
+        // and the level's own acceleration; floor 1.
+        let minv = s.m.clone().try_inverse().unwrap();
+        let reach = (j * minv).norm() * (&full - &upper).norm();
+        let scale = (j * &qdd_full).amax().max(reach).max(1.0);
+        prop_assert!(diff <= 1e-9 * scale, "{file}: level {i} acceleration changed by {diff:e} (scale {scale:e}) by the levels below");
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(1000))]
+
+    #[test]
+    fn hierarchy_strict_priority_property_planar7(
+        u in prop::collection::vec(0.0..1.0f64, 14),
+        refs in prop::collection::vec(-1.0..1.0f64, 5 + 7),
+    ) {
+        strict_priority_case("planar7.urdf", &P7_LEVELS, &u, &refs)?;
+    }
+
+    #[test]
+    fn hierarchy_strict_priority_property_tomm(
+        u in prop::collection::vec(0.0..1.0f64, 30),
+        refs in prop::collection::vec(-1.0..1.0f64, 10 + 15),
+    ) {
+        strict_priority_case("tomm.urdf", &TOMM_LEVELS, &u, &refs)?;
+    }
 }

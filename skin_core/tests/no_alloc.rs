@@ -364,7 +364,7 @@ fn tasks_do_not_allocate_after_setup() {
         guide.update(&model, data, &h_f, l6).unwrap();
         hold.update(&model, data, l7).unwrap();
         base.update(&q, &laser).unwrap();
-        let tau = posture.update(&model, data, &layout, &wrenches, |j| j >= 6, Some(base.torque())).unwrap();
+        let tau = posture.update(&model, data, &layout, &wrenches, |j| j >= 6, Some(base.torque()), true).unwrap();
         std::hint::black_box(tau);
     };
     cycle(&mut data); // first call may size the skin output vectors
@@ -374,4 +374,57 @@ fn tasks_do_not_allocate_after_setup() {
     }
     assert_eq!(allocations() - before, 0, "tasks allocated");
     assert!(levels[2].rows() > 0 && levels[3].rows() > 0);
+}
+
+/// The whole cycle (`Controller::update`) on TOMM with skin activity, a goal and a laser scan,
+/// across arrangement switches of both policies (paper 003 phases on request; paper 000 (a) -> (c)
+/// on a contact force), and through a safe-stop step.
+#[test]
+fn controller_cycle_does_not_allocate_after_setup() {
+    use nalgebra::{Isometry3, Vector2};
+    use skin_core::controller::{Controller, ControllerConfig, ControllerInput};
+
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    for policy in [Policy::Phases, Policy::IntentionalContact] {
+        let mut config = ControllerConfig::load(&root.join("config/controller/tomm.yaml")).unwrap();
+        config.supervisor.policy = policy;
+        let q = config.setup.posture.clone();
+        let nv = q.len();
+        let n = config.layout.num_cells();
+        let mut cells = vec![CellReading::default(); n];
+        for i in (0..n).step_by(11) {
+            cells[i] = CellReading::uniform(0.0, 0.7);
+        }
+        let scan: Vec<Vector2<f64>> = (0..360).map(|k| {
+            let a = (k as f64).to_radians();
+            Vector2::new(a.cos(), a.sin()) * 0.7
+        }).collect();
+        let mut c = Controller::new(config, 0.0).unwrap();
+        c.set_goal(Some(Isometry3::translation(0.6, -0.3, 1.1))).unwrap();
+        let qd = vec![0.01; nv];
+        let mut t = 0.0;
+        let mut step = |c: &mut Controller, cells: &[CellReading], dt: f64| {
+            t += 0.008;
+            c.update(&ControllerInput { t_s: t, dt_s: dt, q: &q, qd: &qd, cells, scan: &scan }).commands.joint_velocities[0]
+        };
+        for _ in 0..5 {
+            step(&mut c, &cells, 0.008);
+        }
+        let before = allocations();
+        for k in 0..60 {
+            if k == 10 {
+                let _ = c.request_phase(Phase::Contact);
+            }
+            if k == 20 {
+                // hard contact on many cells: (a) -> (c) under the paper 000 policy
+                for i in (0..n).step_by(5) {
+                    cells[i] = CellReading::uniform(1.0, 1.0);
+                }
+            }
+            let dt = if k == 30 { f64::NAN } else { 0.008 };
+            std::hint::black_box(step(&mut c, &cells, dt));
+        }
+        assert_eq!(allocations() - before, 0, "{policy:?}: the controller cycle allocated");
+        assert_ne!(c.supervisor().log().total(), 0, "{policy:?}: an arrangement switch happened");
+    }
 }

@@ -6,7 +6,7 @@ use nalgebra::{DMatrix, DVector};
 use crate::model::{bias_forces, crba, ModelData, RobotModel};
 
 use super::dense::{add_mul_vec, axpy, dot, mul, mul_tn, mul_tr_vec, mul_vec, norm, sub_mul_nt};
-use super::inverse::{cholesky, damped_inverse, spd_inverse_from_cholesky, InverseParams};
+use super::inverse::{cholesky, damped_inverse, spd_inverse_from_cholesky, symmetric_eigen, InverseParams};
 use super::{HierarchyError, ReferenceKind, TaskLevel};
 
 /// What one level did in the last solve.
@@ -215,6 +215,12 @@ impl HierarchySolver {
             } else {
                 mul(self.nproj.as_slice(), jt, &mut self.jbt[..nm], n, n, m);
             }
+            if m > n {
+                // more rows than joints (stacked skin cells): the same level in joint space
+                self.wide_level(k, level, &mut diag, &mut first)?;
+                self.diagnostics.push(diag);
+                continue;
+            }
             // Y = M⁻¹ J̄ᵀ, A = J̄ M⁻¹ J̄ᵀ (symmetrized against round-off), Λ̄ (eq. 23)
             mul(minv, &self.jbt[..nm], &mut self.y[..nm], n, n, m);
             mul_tn(&self.jbt[..nm], &self.y[..nm], &mut self.a[..mm], n, m, m);
@@ -291,6 +297,100 @@ impl HierarchySolver {
             return Err(HierarchyError::Overflow { level: nlevels });
         }
         tau_out.as_mut_slice().copy_from_slice(&self.tau_sum);
+        Ok(())
+    }
+
+    /// One level with more rows `m` than joints `n` (J̄ᵀ already in `jbt`), computed with n × n
+    /// matrices only: the m × m `A = J̄ M⁻¹ J̄ᵀ` has rank ≤ n and, with `M = L Lᵀ` and
+    /// `G = J̄ L⁻ᵀ`, the same nonzero eigenvalues `e` as `C = Gᵀ G = L⁻¹ (J̄ᵀ J̄) L⁻ᵀ = V E Vᵀ`.
+    /// With the filter `f` of [`InverseParams`] (so exactly what the m × m path computes):
+    ///
+    /// ```text
+    /// J̄ᵀ Λ̄ J̄ M⁻¹ = L V diag(e f(e)) Vᵀ L⁻¹         (the projector of eq. 24)
+    /// J̄ᵀ Λ̄ r     = L V diag(f(e)) Vᵀ L⁻¹ J̄ᵀ r      (eq. 20)
+    /// ```
+    ///
+    /// Cost `m n² + O(n³)` instead of `O(m³)`: 50 active cells on one level stay cheap.
+    fn wide_level(&mut self, k: usize, level: &TaskLevel, diag: &mut LevelDiagnostics, first: &mut bool) -> Result<(), HierarchyError> {
+        let (n, m) = (self.nv, level.rows());
+        let (nm, nn) = (n * m, n * n);
+        // C = L⁻¹ (J̄ᵀ J̄) L⁻ᵀ, symmetrized; its eigen decomposition
+        self.w[..nn].fill(0.0);
+        sub_mul_nt(&mut self.w[..nn], &self.jbt[..nm], &self.jbt[..nm], n, m, n);
+        mul(&self.linv, &self.w[..nn], &mut self.lam[..nn], n, n, n);
+        self.a[..nn].fill(0.0);
+        sub_mul_nt(&mut self.a[..nn], &self.lam[..nn], &self.linv, n, n, n);
+        for c in 0..n {
+            for r in 0..c {
+                // w = −J̄ᵀJ̄, lam = −L⁻¹J̄ᵀJ̄, a = 0 − lam L⁻ᵀ = C
+                let s = 0.5 * (self.a[c * n + r] + self.a[r * n + c]);
+                self.a[c * n + r] = s;
+                self.a[r * n + c] = s;
+            }
+        }
+        symmetric_eigen(&mut self.a[..nn], &mut self.v[..nn], n);
+        let e_max = (0..n).map(|i| self.a[i * n + i]).fold(0.0, f64::max);
+        let thr = self.params.threshold(e_max);
+        // f(e) into r, e f(e) into s
+        for i in 0..n {
+            let e = self.a[i * n + i];
+            let f = self.params.filter(e, thr);
+            self.r[i] = f;
+            self.s[i] = e * f;
+            if f > 0.0 {
+                diag.min_eigenvalue = if diag.rank == 0 { e } else { diag.min_eigenvalue.min(e) };
+                diag.rank += 1;
+                diag.damped += usize::from(e < self.params.damping);
+            }
+        }
+        diag.rows = m;
+        let (f, ef) = (&self.r[..n], &self.s[..n]);
+
+        // τ̄_k: force level J̄ᵀ F; acceleration level L V f Vᵀ L⁻¹ J̄ᵀ (ẍ* − J̇q̇ − a_k)
+        match level.kind() {
+            ReferenceKind::Force => mul_vec(&self.jbt[..nm], level.target(), &mut self.tau_bar, n, m),
+            ReferenceKind::Acceleration => {
+                let res = &mut self.y[..m];
+                mul_tr_vec(level.jt_slice(), &self.u_sum, res, n, m);
+                for ((ri, x), d) in res.iter_mut().zip(level.target()).zip(level.jdot_qdot()) {
+                    *ri = x - d - *ri;
+                }
+                let (g, rest) = self.z.split_at_mut(n);
+                let (h, p) = rest.split_at_mut(n);
+                mul_vec(&self.jbt[..nm], res, g, n, m);
+                mul_vec(&self.linv, g, h, n, n);
+                mul_tr_vec(&self.v[..nn], h, &mut p[..n], n, n);
+                for (pi, fi) in p[..n].iter_mut().zip(f) {
+                    *pi *= fi;
+                }
+                mul_vec(&self.v[..nn], &p[..n], g, n, n);
+                mul_vec(&self.chol, g, &mut self.tau_bar, n, n);
+            }
+        }
+        axpy(1.0, &self.tau_bar, &mut self.tau_sum);
+        add_mul_vec(self.minv.as_slice(), &self.tau_bar, &mut self.u_sum, n, n);
+        diag.torque_norm = norm(&self.tau_bar);
+        if !self.tau_sum.iter().all(|t| t.is_finite()) {
+            return Err(HierarchyError::Overflow { level: k });
+        }
+
+        // N_k = N_{k−1} − (N_{k−1} L V) (L⁻ᵀ V diag(e f))ᵀ
+        if diag.rank > 0 {
+            mul(&self.chol, &self.v[..nn], &mut self.w[..nn], n, n, n);
+            mul_tn(&self.linv, &self.v[..nn], &mut self.lam[..nn], n, n, n);
+            for (col, s) in self.lam[..nn].chunks_exact_mut(n).zip(ef) {
+                for x in col {
+                    *x *= s;
+                }
+            }
+            if *first {
+                self.z[..nn].copy_from_slice(&self.w[..nn]);
+            } else {
+                mul(self.nproj.as_slice(), &self.w[..nn], &mut self.z[..nn], n, n, n);
+            }
+            sub_mul_nt(self.nproj.as_mut_slice(), &self.z[..nn], &self.lam[..nn], n, n, n);
+            *first = false;
+        }
         Ok(())
     }
 

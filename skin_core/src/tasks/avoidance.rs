@@ -15,7 +15,7 @@ use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::LengthMismatch;
 use crate::skin::characteristic::ProximityCharacteristic;
-use crate::skin::layout::ResolvedLayout;
+use crate::skin::layout::{ResolvedCell, ResolvedLayout};
 use crate::skin::repulsion::linear_repulsion;
 use crate::skin::signals::CellReading;
 
@@ -59,8 +59,37 @@ impl ProximityAvoidance {
         range_m: f64,
         level: &mut TaskLevel,
     ) -> Result<AvoidanceSummary, TaskError> {
-        LengthMismatch::check_readings(layout, readings)?;
         level.clear();
+        let jac = &mut self.jac;
+        self.params.cells_in_range(layout, readings, proximity, range_m, |cell, f| {
+            push_inward_cell_row(model, data, cell, f, jac, level)
+        })
+    }
+
+    /// The summary [`Self::update`] would return, without the rows (no Jacobians): what the
+    /// supervisor needs when the task is not in the active arrangement.
+    pub fn summarize(
+        &self,
+        layout: &ResolvedLayout,
+        readings: &[CellReading],
+        proximity: &ProximityCharacteristic,
+        range_m: f64,
+    ) -> Result<AvoidanceSummary, TaskError> {
+        self.params.cells_in_range(layout, readings, proximity, range_m, |_, _| Ok(()))
+    }
+}
+
+impl AvoidanceParams {
+    /// Calls `row(cell, F_di)` for every cell within the range (eq. 3) and sums them up.
+    fn cells_in_range(
+        &self,
+        layout: &ResolvedLayout,
+        readings: &[CellReading],
+        proximity: &ProximityCharacteristic,
+        range_m: f64,
+        mut row: impl FnMut(&ResolvedCell, f64) -> Result<(), TaskError>,
+    ) -> Result<AvoidanceSummary, TaskError> {
+        LengthMismatch::check_readings(layout, readings)?;
         let mut s = AvoidanceSummary { min_distance_m: f64::INFINITY, ..Default::default() };
         let range = range_m.min(proximity.range_m);
         if range.is_nan() || range <= 0.0 {
@@ -77,8 +106,8 @@ impl ProximityAvoidance {
             if d >= range {
                 continue;
             }
-            let f = linear_repulsion(self.params.gain_n_per_m, range, d);
-            push_inward_cell_row(model, data, cell, f, &mut self.jac, level)?;
+            let f = linear_repulsion(self.gain_n_per_m, range, d);
+            row(cell, f)?;
             s.rows += 1;
             sum_sq += f * f;
             s.max_force_n = s.max_force_n.max(f);

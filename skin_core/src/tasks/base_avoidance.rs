@@ -16,6 +16,21 @@ use nalgebra::{DVector, Vector2, Vector3};
 use super::params::BaseAvoidanceParams;
 use super::TaskError;
 
+/// A pseudo-angle of the direction `(x, y)` in `[0, 4)`: 0 along +x, 1 along +y, 2 along −x, 3
+/// along −y, strictly increasing with the angle in `[0, 2π)`; four divisions, no `atan2`.
+fn diamond_angle(y: f64, x: f64) -> f64 {
+    let s = x.abs() + y.abs();
+    if s == 0.0 {
+        return 0.0;
+    }
+    match (y >= 0.0, x >= 0.0) {
+        (true, true) => y / s,
+        (true, false) => 1.0 - x / s,
+        (false, false) => 2.0 - y / s,
+        (false, true) => 3.0 + x / s,
+    }
+}
+
 /// Summary of one base-avoidance update.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct BaseAvoidanceSummary {
@@ -33,7 +48,10 @@ pub struct BaseAvoidance {
     /// Footprint, range and repulsion parameters.
     pub params: BaseAvoidanceParams,
     joints: [usize; 3],
+    /// Per sector: squared footprint distance, the point, its closest footprint point.
     best: Vec<(f64, Vector2<f64>, Vector2<f64>)>,
+    /// Pseudo-angles of the inner sector bounds `2π k/n`, k = 1..n.
+    bounds: Vec<f64>,
     tau: DVector<f64>,
 }
 
@@ -47,7 +65,22 @@ impl BaseAvoidance {
         if params.sectors == 0 {
             return Err(TaskError::Length { what: "base_avoidance.sectors (must be >= 1)", expected: 1, got: 0 });
         }
-        Ok(Self { params, joints, best: vec![(f64::INFINITY, Vector2::zeros(), Vector2::zeros()); params.sectors], tau: DVector::zeros(nv) })
+        let n = params.sectors;
+        let bounds = (1..n)
+            .map(|k| {
+                let (s, c) = (std::f64::consts::TAU * k as f64 / n as f64).sin_cos();
+                diamond_angle(s, c)
+            })
+            .collect();
+        Ok(Self { params, joints, best: vec![(f64::INFINITY, Vector2::zeros(), Vector2::zeros()); n], bounds, tau: DVector::zeros(nv) })
+    }
+
+    /// The sector of `p`: sector `s` spans the angles `atan2(y, x) + π ∈ [2π s/n, 2π (s+1)/n)`.
+    /// Compared in the pseudo-angle of [`diamond_angle`] (monotone in the angle, no `atan2`)
+    /// against the sector bounds precomputed in it.
+    fn sector(&self, p: &Vector2<f64>) -> usize {
+        let a = diamond_angle(-p.y, -p.x);
+        self.bounds.iter().take_while(|&&b| a >= b).count()
     }
 
     /// Closest footprint point to `p` (base frame) and its distance (0 inside).
@@ -67,26 +100,30 @@ impl BaseAvoidance {
         for b in self.best.iter_mut() {
             b.0 = f64::INFINITY;
         }
-        let n = self.best.len();
+        let (fx, fy) = (self.params.footprint_x_m, self.params.footprint_y_m);
+        let range_sq = self.params.range_m * self.params.range_m;
+        // squared distances in the scan loop (a scan has hundreds of points); the square root
+        // and the sector's angle only for points in range
         for p in points {
             if !(p.x.is_finite() && p.y.is_finite()) {
                 continue;
             }
-            let (c, d) = self.closest_footprint_point(p);
-            if d <= 0.0 || d > self.params.range_m {
+            let c = Vector2::new(p.x.clamp(fx[0], fx[1]), p.y.clamp(fy[0], fy[1]));
+            let d_sq = (p - c).norm_squared();
+            if d_sq <= 0.0 || d_sq > range_sq {
                 continue;
             }
-            let angle = p.y.atan2(p.x) + std::f64::consts::PI; // [0, 2π]
-            let s = ((angle / std::f64::consts::TAU * n as f64) as usize).min(n - 1);
-            if d < self.best[s].0 {
-                self.best[s] = (d, *p, c);
+            let s = self.sector(p);
+            if d_sq < self.best[s].0 {
+                self.best[s] = (d_sq, *p, c);
             }
         }
         let mut sum = BaseAvoidanceSummary { min_distance_m: f64::INFINITY, ..Default::default() };
-        for &(d, p, c) in &self.best {
-            if !d.is_finite() {
+        for &(d_sq, p, c) in &self.best {
+            if !d_sq.is_finite() {
                 continue;
             }
+            let d = d_sq.sqrt();
             let nrm = (p - c) / d;
             let f = self.params.f_max_n * (-d / self.params.alpha_m).exp();
             // eq. (17)ᵀ n f: [n_x, n_y, −x̄_y n_x + x̄_x n_y] f
@@ -105,5 +142,34 @@ impl BaseAvoidance {
     /// `τ_oca` of the last update (toward the obstacles; eq. 18 subtracts it).
     pub fn torque(&self) -> &DVector<f64> {
         &self.tau
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tasks::params::BaseAvoidanceParams;
+
+    /// The pseudo-angle binning equals the `atan2` definition of the sectors.
+    #[test]
+    fn sectors_match_atan2() {
+        for n in [1, 3, 8, 13] {
+            let params = BaseAvoidanceParams {
+                f_max_n: 1.0,
+                alpha_m: 0.1,
+                range_m: 1.0,
+                footprint_x_m: [-0.1, 0.1],
+                footprint_y_m: [-0.1, 0.1],
+                sectors: n,
+            };
+            let b = BaseAvoidance::new(3, [0, 1, 2], params).unwrap();
+            for k in 0..3600 {
+                let a = (k as f64 + 0.37) * std::f64::consts::TAU / 3600.0;
+                let p = Vector2::new(a.cos(), a.sin()) * (0.5 + (k % 7) as f64);
+                let angle = p.y.atan2(p.x) + std::f64::consts::PI;
+                let want = ((angle / std::f64::consts::TAU * n as f64) as usize).min(n - 1);
+                assert_eq!(b.sector(&p), want, "n = {n}, angle {a}");
+            }
+        }
     }
 }

@@ -16,7 +16,7 @@ use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::{FusionParams, LengthMismatch};
 use crate::skin::characteristic::ForceCharacteristic;
-use crate::skin::layout::ResolvedLayout;
+use crate::skin::layout::{ResolvedCell, ResolvedLayout};
 use crate::skin::signals::CellReading;
 
 /// Contact reaction over all cells of a layout.
@@ -56,8 +56,36 @@ impl ContactReaction {
         fusion: &FusionParams,
         level: &mut TaskLevel,
     ) -> Result<ContactSummary, TaskError> {
-        LengthMismatch::check_readings(layout, readings)?;
         level.clear();
+        let jac = &mut self.jac;
+        self.params.contact_cells(layout, readings, force, fusion, |cell, f| {
+            push_inward_cell_row(model, data, cell, f, jac, level)
+        })
+    }
+
+    /// The summary [`Self::update`] would return, without the rows (no Jacobians).
+    pub fn summarize(
+        &self,
+        layout: &ResolvedLayout,
+        readings: &[CellReading],
+        force: &ForceCharacteristic,
+        fusion: &FusionParams,
+    ) -> Result<ContactSummary, TaskError> {
+        self.params.contact_cells(layout, readings, force, fusion, |_, _| Ok(()))
+    }
+}
+
+impl ContactReactionParams {
+    /// Calls `row(cell, F_ci)` for every cell in contact (eq. 6) and sums them up.
+    fn contact_cells(
+        &self,
+        layout: &ResolvedLayout,
+        readings: &[CellReading],
+        force: &ForceCharacteristic,
+        fusion: &FusionParams,
+        mut row: impl FnMut(&ResolvedCell, f64) -> Result<(), TaskError>,
+    ) -> Result<ContactSummary, TaskError> {
+        LengthMismatch::check_readings(layout, readings)?;
         let mut s = ContactSummary::default();
         let force = force.prepared();
         for (cell, reading) in layout.cells().iter().zip(readings) {
@@ -66,8 +94,8 @@ impl ContactReaction {
                 continue;
             }
             let measured = force.force_n(sig);
-            let f = (self.params.gain * measured).min(self.params.max_force_n);
-            push_inward_cell_row(model, data, cell, f, &mut self.jac, level)?;
+            let f = (self.gain * measured).min(self.max_force_n);
+            row(cell, f)?;
             s.rows += 1;
             s.max_force_n = s.max_force_n.max(f);
             s.max_measured_n = s.max_measured_n.max(measured);

@@ -50,8 +50,11 @@ impl Posture {
     }
 
     /// Computes `τ_c*` at the state of the last `update_kinematics` from the patch wrenches of the
-    /// body patches selected by `include` and the optional `τ_oca`; returns it (pass
-    /// `Some(posture.update(..)?.as_slice())` to the solver).
+    /// body patches selected by `include` and the optional `τ_oca`; `joint = false` leaves out the
+    /// joint compliance `−K_c (q − q_post) − D_c q̇` (an arrangement with body compliance or base
+    /// avoidance but no posture). Returns it (pass `Some(posture.update(..)?.as_slice())` to the
+    /// solver).
+    #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
         model: &RobotModel,
@@ -60,6 +63,7 @@ impl Posture {
         wrenches: &[PatchWrench],
         include: impl Fn(usize) -> bool,
         tau_oca: Option<&DVector<f64>>,
+        joint: bool,
     ) -> Result<&DVector<f64>, TaskError> {
         let nv = self.tau.len();
         if data.q().len() != nv {
@@ -70,9 +74,11 @@ impl Posture {
         }
         patch_wrenches_to_torques(model, data, layout, wrenches, include, &mut self.tau_skin);
         let (q, qd) = (data.q(), data.qd());
+        let joint = if joint { 1.0 } else { 0.0 };
         for i in 0..nv {
             let oca = tau_oca.map_or(0.0, |t| t[i]);
-            self.tau[i] = -self.k_c[i] * (q[i] - self.q_post[i]) - self.d_c[i] * qd[i] - (self.skin_gain * self.tau_skin[i] + oca);
+            let compliance = -self.k_c[i] * (q[i] - self.q_post[i]) - self.d_c[i] * qd[i];
+            self.tau[i] = joint * compliance - (self.skin_gain * self.tau_skin[i] + oca);
         }
         Ok(&self.tau)
     }

@@ -260,7 +260,7 @@ fn posture_at_rest_posture_is_pure_damping() {
     update_kinematics(&s.model, &mut s.data, &s.q, &qd).unwrap();
     let mut posture = Posture::new(nv, &s.params.posture, &s.q).unwrap();
     let wrenches = vec![PatchWrench::default(); s.layout.patches().len()];
-    let tau = posture.update(&s.model, &s.data, &s.layout, &wrenches, |_| true, None).unwrap().clone();
+    let tau = posture.update(&s.model, &s.data, &s.layout, &wrenches, |_| true, None, true).unwrap().clone();
     for i in 0..nv {
         assert_relative_eq!(tau[i], -posture.d_c[i] * qd[i], epsilon = 1e-12);
     }
@@ -287,7 +287,7 @@ fn base_avoidance_pushes_back_with_eq17_yaw_term() {
     let mut data = ModelData::new(&s.model);
     update_kinematics(&s.model, &mut data, &q, &vec![0.0; nv]).unwrap();
     let wrenches = vec![PatchWrench::default(); s.layout.patches().len()];
-    let tau = posture.update(&s.model, &data, &s.layout, &wrenches, |_| true, Some(base.torque())).unwrap();
+    let tau = posture.update(&s.model, &data, &s.layout, &wrenches, |_| true, Some(base.torque()), true).unwrap();
     assert!(tau[joints[0]] < 0.0);
     assert_relative_eq!(tau[joints[2]], y * f, epsilon = 1e-12);
     // with the base turned by 90°, "backward" is world −y
@@ -320,7 +320,7 @@ fn three_tasks_and_posture_through_the_solver() {
     assert!(sum.rows > 0);
     hand_task.update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.1 }, &s.skin.proximity, l1).unwrap();
     hold.update(&s.model, &s.data, l2).unwrap();
-    let tau_c = posture.update(&s.model, &s.data, &s.layout, &wrenches, |_| true, None).unwrap().clone();
+    let tau_c = posture.update(&s.model, &s.data, &s.layout, &wrenches, |_| true, None, true).unwrap().clone();
     let mut solver = HierarchySolver::new(nv, 3, n, InverseParams::default()).unwrap();
     let mut tau = DVector::zeros(nv);
     solver.solve_model(&s.model, &mut s.data, levels.iter(), Some(tau_c.as_slice()), true, &mut tau).unwrap();

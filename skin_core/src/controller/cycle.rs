@@ -1,0 +1,357 @@
+//! [`Controller`]: one control cycle from measurements to velocity commands.
+
+use nalgebra::{DVector, Isometry3, Matrix6xX};
+
+use super::io::{ControllerInput, ControllerOutput, Fault};
+use super::setup::{ControllerConfig, SetupError};
+use super::task_set::{CycleContext, HandSignals, TaskSet};
+use crate::hierarchy::{HierarchySolver, LevelDiagnostics};
+use crate::model::{gravity, point_jacobian, update_kinematics, ModelData};
+use crate::resolver::{Commands, Resolver};
+use crate::skin::aggregate::{aggregate_patches, FusionParams, PatchWrench};
+use crate::skin::transforms::{patch_poses_world, patch_wrench_world, sum_patch_forces_in_frame};
+use crate::supervisor::blend::chi;
+use crate::supervisor::{Arrangement, Phase, PhaseRefused, Supervisor, SupervisorInput, TorqueBlender};
+use crate::tasks::rows_times_qd;
+
+/// Maps a stage's error to [`Fault::Stage`] (the error's text would allocate).
+fn stage<E>(name: &'static str) -> impl FnOnce(E) -> Fault {
+    move |_| Fault::Stage(name)
+}
+
+/// The whole control law of both papers behind one call per cycle:
+///
+/// 1. kinematics at the measured state; the supervisor's signals (end-effector speed, `‖F_d‖` at
+///    the nominal range, `‖F_c‖`, goal error) and its arrangement (paper 000 Table I or paper 003
+///    Table 1);
+/// 2. the skin: cells fused with the arrangement's weight `w(t)` (paper 003 eq. 6) into patch
+///    wrenches (eq. 7-8), and the hand signals of eq. (9)-(11);
+/// 3. the arrangement's tasks filled in priority order, the posture torque of eq. (18) with the
+///    terms the arrangement names, solved by the hierarchy (paper 003 eq. 19-25, with the bias
+///    `C q̇ + g`);
+/// 4. the torque blended across arrangement switches (paper 000 eq. 10-11);
+/// 5. the admittance resolver (paper 003 eq. 26) turns it into joint and base velocity commands
+///    within the limits.
+///
+/// Bad input (wrong lengths, NaN state, bad `dt`) or a failed stage makes the cycle a safe-stop
+/// step instead (`ControllerOutput::fault`), so the commands are always finite and within the
+/// limits. The first valid measured state resets the resolver (commands continue from the
+/// measured motion); before it the commands are zero. After [`Controller::new`] nothing allocates (`tests/no_alloc.rs`).
+#[derive(Debug, Clone)]
+pub struct Controller {
+    config: ControllerConfig,
+    data: ModelData,
+    tasks: TaskSet,
+    solver: HierarchySolver,
+    resolver: Resolver,
+    supervisor: Supervisor,
+    blender: TorqueBlender,
+    /// End-effector frame index.
+    ee: usize,
+    hand_patches: Vec<bool>,
+    guidance_patches: Vec<bool>,
+    /// Patches that are not hand patches: the body of eq. (13)-(14).
+    body_patches: Vec<bool>,
+    goal: Option<Isometry3<f64>>,
+    fusion: FusionParams,
+    wrenches: Vec<PatchWrench>,
+    patch_poses: Vec<Isometry3<f64>>,
+    ee_jacobian: Matrix6xX<f64>,
+    tau_k: DVector<f64>,
+    tau: DVector<f64>,
+    gravity: DVector<f64>,
+    /// The resolver has been reset from a valid measured state.
+    started: bool,
+    output: ControllerOutput,
+}
+
+impl Controller {
+    /// Builds the controller at time `t0_s`: checks that frames, patches, task names and the
+    /// posture fit the model, and allocates every buffer.
+    pub fn new(config: ControllerConfig, t0_s: f64) -> Result<Self, SetupError> {
+        let model = &config.model;
+        let nv = model.nv();
+        let ee = model.frame_index(&config.setup.end_effector).ok_or_else(|| {
+            config.invalid("end_effector", format!("frame `{}` is not in {}", config.setup.end_effector, model.source()))
+        })?;
+        if !config.setup.posture.is_empty() && config.setup.posture.len() != nv {
+            let reason = format!("has {} values, the model has {nv} joints", config.setup.posture.len());
+            return Err(config.invalid("posture", reason));
+        }
+        config.setup.inverse.validate().map_err(|error| SetupError::Inverse { file: config.source.clone(), error })?;
+        let hand_patches = config.patch_mask("hand_patches", &config.setup.hand_patches)?;
+        let guidance_patches = config.patch_mask("guidance_patches", &config.setup.guidance_patches)?;
+        let body_patches = hand_patches.iter().map(|h| !h).collect();
+        let tasks = TaskSet::new(&config, ee)?;
+        let max_rows = tasks.levels.iter().map(|l| l.max_rows()).max().unwrap_or(0);
+        let solver = HierarchySolver::new(nv, tasks.levels.len(), max_rows, config.setup.inverse)
+            .map_err(|error| SetupError::Inverse { file: config.source.clone(), error })?;
+        let resolver = Resolver::new(model, config.resolver.clone())
+            .map_err(|error| SetupError::Resolver { file: config.setup.resolver.display().to_string(), error })?;
+        let supervisor = Supervisor::new(&config.supervisor, t0_s)?;
+        let output = ControllerOutput {
+            commands: resolver.commands().clone(),
+            fault: None,
+            mode: supervisor.mode(),
+            blend: 0.0,
+            signals: SupervisorInput::default(),
+            torque_norm: 0.0,
+        };
+        Ok(Controller {
+            data: ModelData::new(model),
+            solver,
+            resolver,
+            blender: TorqueBlender::new(nv),
+            ee,
+            hand_patches,
+            guidance_patches,
+            body_patches,
+            goal: None,
+            fusion: config.skin.fusion,
+            wrenches: Vec::with_capacity(config.layout.patches().len()),
+            patch_poses: Vec::with_capacity(config.layout.patches().len()),
+            ee_jacobian: Matrix6xX::zeros(nv),
+            tau_k: DVector::zeros(nv),
+            tau: DVector::zeros(nv),
+            gravity: DVector::zeros(nv),
+            started: false,
+            output,
+            tasks,
+            supervisor,
+            config,
+        })
+    }
+
+    /// Loads the setup file at `path` ([`ControllerConfig::load`]) and builds the controller.
+    pub fn from_setup_file(path: &std::path::Path, t0_s: f64) -> Result<Self, SetupError> {
+        Self::new(ControllerConfig::load(path)?, t0_s)
+    }
+
+    /// The configuration the controller was built from.
+    pub fn config(&self) -> &ControllerConfig {
+        &self.config
+    }
+
+    /// Sets the end-effector goal (world frame; the orientation is used by `goal_orientation`),
+    /// or clears it (`None`: the goal tasks are empty). A non-finite pose is refused.
+    pub fn set_goal(&mut self, goal: Option<Isometry3<f64>>) -> Result<(), Fault> {
+        if let Some(g) = &goal {
+            let finite = g.translation.vector.iter().chain(g.rotation.coords.iter()).all(|v| v.is_finite());
+            if !finite {
+                return Err(Fault::NonFinite { input: "goal", index: 0 });
+            }
+        }
+        self.goal = goal;
+        Ok(())
+    }
+
+    /// The current goal.
+    pub fn goal(&self) -> Option<&Isometry3<f64>> {
+        self.goal.as_ref()
+    }
+
+    /// Sets the desired fused hand signal `f_c,d` of paper 003 eq. (9) (clamped to [0, 1]; NaN
+    /// is refused).
+    pub fn set_hand_force_reference(&mut self, signal: f64) -> Result<(), Fault> {
+        if signal.is_nan() {
+            return Err(Fault::NonFinite { input: "hand force reference", index: 0 });
+        }
+        self.tasks.set_hand_force_reference(signal.clamp(0.0, 1.0));
+        Ok(())
+    }
+
+    /// Requests a paper 003 phase (effective at the next update).
+    pub fn request_phase(&mut self, phase: Phase) -> Result<(), PhaseRefused> {
+        self.supervisor.request_phase(phase)
+    }
+
+    /// The supervisor (mode, arrangement, transition log).
+    pub fn supervisor(&self) -> &Supervisor {
+        &self.supervisor
+    }
+
+    /// The active arrangement.
+    pub fn arrangement(&self) -> &Arrangement {
+        self.supervisor.arrangement()
+    }
+
+    /// Per-level diagnostics of the last solve, in the arrangement's priority order (level
+    /// tasks only).
+    pub fn level_diagnostics(&self) -> &[LevelDiagnostics] {
+        self.solver.diagnostics()
+    }
+
+    /// The patch wrenches of the last cycle (layout patch order).
+    pub fn patch_wrenches(&self) -> &[PatchWrench] {
+        &self.wrenches
+    }
+
+    /// The blended joint torque `τ*` of the last cycle (model order).
+    pub fn torque(&self) -> &DVector<f64> {
+        &self.tau
+    }
+
+    /// The output of the last cycle.
+    pub fn output(&self) -> &ControllerOutput {
+        &self.output
+    }
+
+    /// The resolver (arm joint order, limits).
+    pub fn resolver(&self) -> &Resolver {
+        &self.resolver
+    }
+
+    /// One control cycle. Always returns commands that are safe to send.
+    pub fn update(&mut self, input: &ControllerInput) -> &ControllerOutput {
+        match self.run(input) {
+            Ok(()) => self.output.fault = None,
+            Err(fault) => {
+                self.resolver.safe_stop(input.dt_s);
+                self.output.fault = Some(fault);
+            }
+        }
+        let c: &Commands = self.resolver.commands();
+        self.output.commands.joint_velocities.copy_from_slice(&c.joint_velocities);
+        self.output.commands.base_twist = c.base_twist;
+        &self.output
+    }
+
+    /// Lengths and finiteness of the measured state.
+    fn check_state(&self, input: &ControllerInput) -> Result<(), Fault> {
+        let nv = self.config.model.nv();
+        for (name, v) in [("q", input.q), ("qd", input.qd)] {
+            if v.len() != nv {
+                return Err(Fault::Length { input: name, expected: nv, got: v.len() });
+            }
+            if let Some(index) = v.iter().position(|x| !x.is_finite()) {
+                return Err(Fault::NonFinite { input: name, index });
+            }
+        }
+        Ok(())
+    }
+
+    /// The other inputs: one reading per cell, a usable time step.
+    fn check_rest(&self, input: &ControllerInput) -> Result<(), Fault> {
+        let cells = self.config.layout.num_cells();
+        if input.cells.len() != cells {
+            return Err(Fault::Length { input: "cells", expected: cells, got: input.cells.len() });
+        }
+        if !(input.dt_s.is_finite() && input.dt_s > 0.0) {
+            return Err(Fault::BadTimeStep);
+        }
+        Ok(())
+    }
+
+    fn run(&mut self, input: &ControllerInput) -> Result<(), Fault> {
+        self.check_state(input)?;
+        let first = !self.started;
+        if first {
+            // start from the measured motion (a safe stop then ramps down from it, no jump)
+            self.resolver.reset(input.q, input.qd).map_err(stage("resolver reset"))?;
+            self.started = true;
+        }
+        self.check_rest(input)?;
+        update_kinematics(&self.config.model, &mut self.data, input.q, input.qd).map_err(stage("kinematics"))?;
+
+        // 1. signals and arrangement
+        let signals = self.signals(input)?;
+        self.output.signals = signals;
+        self.supervisor.update(input.t_s, &signals);
+        if first || self.supervisor.last_transition().is_some() {
+            self.tasks.hold.capture(&self.data); // x_ef,init of paper 003 Table 1's contact phase
+        }
+        let arrangement = self.supervisor.arrangement();
+        let model = &self.config.model;
+
+        // 2. skin: fused with w(t), patch wrenches, hand signals
+        self.fusion.weight_force = arrangement.fusion_weight;
+        let layout = &self.config.layout;
+        aggregate_patches(layout, input.cells, &self.fusion, &mut self.wrenches).map_err(stage("skin aggregation"))?;
+        let data = &self.data;
+        patch_poses_world(layout, |f| data.frame_pose(f), &mut self.patch_poses);
+
+        // 3. tasks in priority order, posture, hierarchy
+        let cx = CycleContext {
+            model,
+            data,
+            config: &self.config,
+            cells: input.cells,
+            hand: self.hand_signals(),
+            goal: self.goal.as_ref(),
+            sensing_range_m: arrangement.sensing_range_m,
+        };
+        let order = arrangement.task_order();
+        for &i in order {
+            self.tasks.fill(i, &cx).map_err(stage("task update"))?;
+        }
+        let has_posture = self
+            .tasks
+            .posture_torque(order, model, data, &self.config, &self.wrenches, &self.body_patches, input.scan)
+            .map_err(stage("posture torque"))?;
+        let posture = has_posture.then(|| self.tasks.posture.torque().as_slice());
+        let (kinds, levels) = (&self.tasks.kinds, &self.tasks.levels);
+        let active = order.iter().filter(|&&i| kinds[i].is_level()).map(|&i| &levels[i]);
+        self.solver
+            .solve_model(model, &mut self.data, active, posture, true, &mut self.tau_k)
+            .map_err(stage("hierarchy"))?;
+
+        // 4. blend across switches
+        self.blender.sync(arrangement);
+        self.blender.apply(input.t_s, self.tau_k.as_slice(), self.tau.as_mut_slice());
+        self.output.blend = if self.blender.is_blending() {
+            chi(arrangement.smoothing_gain_per_s, input.t_s - arrangement.switch_time_s)
+        } else {
+            0.0
+        };
+        self.output.mode = arrangement.mode;
+        self.output.torque_norm = self.tau.norm();
+
+        // 5. admittance resolver
+        gravity(model, &mut self.data, &mut self.gravity).map_err(stage("gravity"))?;
+        self.resolver
+            .update(self.tau.as_slice(), self.gravity.as_slice(), input.q, input.qd, input.dt_s)
+            .map_err(stage("resolver"))?;
+        Ok(())
+    }
+
+    /// The supervisor's inputs: `‖F_d‖` at the nominal range, the largest contact force, the
+    /// end-effector speed and goal error (task summaries only: no rows are built here).
+    fn signals(&mut self, input: &ControllerInput) -> Result<SupervisorInput, Fault> {
+        let (model, data, config) = (&self.config.model, &self.data, &self.config);
+        let (skin, layout) = (&config.skin, &config.layout);
+        let nominal = config.supervisor.sensing_range.nominal_m;
+        let avoid = self.tasks.avoidance.summarize(layout, input.cells, &skin.proximity, nominal).map_err(stage("avoidance"))?;
+        let contact = self.tasks.contact.summarize(layout, input.cells, &skin.force, &skin.fusion).map_err(stage("contact reaction"))?;
+        point_jacobian(model, data, self.ee, &nalgebra::Vector3::zeros(), &mut self.ee_jacobian)
+            .map_err(stage("end-effector Jacobian"))?;
+        let speed = rows_times_qd(&self.ee_jacobian, 0, input.qd).norm();
+        let goal_error = self.goal.as_ref().map_or(f64::NAN, |g| {
+            (g.translation.vector - data.frame_pose(self.ee).translation.vector).norm()
+        });
+        Ok(SupervisorInput {
+            ee_speed_mps: speed,
+            avoidance_force_n: avoid.force_norm_n,
+            contact_force_n: contact.max_measured_n,
+            goal_error_m: goal_error,
+        })
+    }
+
+    /// Paper 003 eq. (9)-(11) inputs from the patch wrenches of this cycle.
+    fn hand_signals(&self) -> HandSignals {
+        let hand_pose = self.data.frame_pose(self.ee);
+        let (poses, wrenches) = (&self.patch_poses, &self.wrenches);
+        let in_hand = sum_patch_forces_in_frame(hand_pose, poses, wrenches, |j| self.hand_patches[j]);
+        let mut s = HandSignals {
+            fused_force: in_hand.z,
+            guidance_force: sum_patch_forces_in_frame(hand_pose, poses, wrenches, |j| self.guidance_patches[j]),
+            ..HandSignals::default()
+        };
+        for (j, (pose, w)) in poses.iter().zip(wrenches).enumerate() {
+            if self.hand_patches[j] {
+                s.proximity = s.proximity.max(w.max_proximity_signal);
+                s.moment_world += patch_wrench_world(pose, w).moment;
+            }
+        }
+        s
+    }
+}

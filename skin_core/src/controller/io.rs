@@ -1,0 +1,81 @@
+//! What goes into and comes out of one control cycle.
+
+use nalgebra::Vector2;
+
+use crate::resolver::Commands;
+use crate::skin::signals::CellReading;
+use crate::supervisor::{Mode, SupervisorInput};
+
+/// The measurements of one cycle. Vectors are in model joint order (`RobotModel::joint_names`),
+/// cells in layout order (`ResolvedLayout::cells`).
+#[derive(Debug, Clone, Copy)]
+pub struct ControllerInput<'a> {
+    /// Time of the measurements \[s\] (simulation or ROS time; should not decrease).
+    pub t_s: f64,
+    /// Time since the previous cycle \[s\] (the resolver's integration step).
+    pub dt_s: f64,
+    /// Measured joint positions (base joints: world x, y \[m\], yaw \[rad\]).
+    pub q: &'a [f64],
+    /// Measured joint velocities.
+    pub qd: &'a [f64],
+    /// One reading per skin cell.
+    pub cells: &'a [CellReading],
+    /// Laser points in the base frame \[m\] (empty: nothing seen).
+    pub scan: &'a [Vector2<f64>],
+}
+
+/// Why a cycle fell back to the safe stop (commands ramp to zero within the acceleration
+/// limits). `Copy`, so reporting it allocates nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fault {
+    /// An input vector has the wrong length.
+    Length {
+        /// `q`, `qd` or `cells`.
+        input: &'static str,
+        /// Expected length.
+        expected: usize,
+        /// Given length.
+        got: usize,
+    },
+    /// A joint position or velocity is NaN or infinite.
+    NonFinite {
+        /// `q` or `qd`.
+        input: &'static str,
+        /// Joint index.
+        index: usize,
+    },
+    /// `dt_s` is not a positive finite number.
+    BadTimeStep,
+    /// A stage failed (kinematics, a task, the solver, the resolver); the stage is named.
+    Stage(&'static str),
+}
+
+impl std::fmt::Display for Fault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Fault::Length { input, expected, got } => write!(f, "`{input}` has length {got}, expected {expected}"),
+            Fault::NonFinite { input, index } => write!(f, "`{input}[{index}]` is not finite"),
+            Fault::BadTimeStep => write!(f, "`dt_s` is not a positive finite number"),
+            Fault::Stage(stage) => write!(f, "{stage} failed"),
+        }
+    }
+}
+
+/// The result of one cycle (what `ControllerState.msg` and the command topics carry).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ControllerOutput {
+    /// The velocity commands to send (always finite and within the limits).
+    pub commands: Commands,
+    /// `None` when the control law ran; otherwise why this cycle is a safe-stop step.
+    pub fault: Option<Fault>,
+    /// The active arrangement's mode.
+    pub mode: Mode,
+    /// `χ` of paper 000 eq. (10)-(11): the weight of the previous arrangement's torque (0: no
+    /// blend in progress).
+    pub blend: f64,
+    /// The signals the supervisor decided on (ee speed, `‖F_d‖` at the nominal range, `‖F_c‖`,
+    /// goal error; the goal error is NaN without a goal).
+    pub signals: SupervisorInput,
+    /// `‖τ*‖` of the blended torque \[N m\].
+    pub torque_norm: f64,
+}

@@ -1,0 +1,18 @@
+//! The control cycle: model, skin, tasks, supervisor, hierarchy and resolver composed behind one
+//! [`Controller::update`] per cycle (measurements in, velocity commands out), allocation-free
+//! after [`Controller::new`]. Built from a setup file (`config/controller/<robot>.yaml`,
+//! [`ControllerConfig::load`]) that names the URDF, the skin layout, the parameter files and the
+//! frames the tasks act on. `docs/controller.md` describes the cycle.
+
+mod cycle;
+mod io;
+mod setup;
+mod task_set;
+
+#[cfg(test)]
+mod tests;
+
+pub use cycle::Controller;
+pub use io::{ControllerInput, ControllerOutput, Fault};
+pub use setup::{ControllerConfig, ControllerSetup, SetupError};
+pub use task_set::TaskKind;

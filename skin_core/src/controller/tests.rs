@@ -1,0 +1,126 @@
+use std::path::PathBuf;
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+
+use super::*;
+use crate::skin::signals::CellReading;
+use crate::supervisor::Mode;
+
+fn setup(robot: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../config/controller/{robot}.yaml"))
+}
+
+fn controller(robot: &str) -> Controller {
+    Controller::from_setup_file(&setup(robot), 0.0).unwrap()
+}
+
+/// Writes a modified copy of a shipped setup next to it (so its relative paths still resolve).
+fn setup_error(robot: &str, from: &str, to: &str) -> String {
+    let text = std::fs::read_to_string(setup(robot)).unwrap().replace(from, to);
+    assert!(text.contains(to));
+    let path = setup(robot).with_file_name(format!(".test_{robot}_{}.yaml", std::process::id()));
+    std::fs::write(&path, text).unwrap();
+    let err = Controller::from_setup_file(&path, 0.0).unwrap_err().to_string();
+    std::fs::remove_file(&path).unwrap();
+    err
+}
+
+/// Moves the state as a perfect velocity-controlled robot would: q̇ = command, q += q̇ dt.
+fn follow(c: &Controller, q: &mut [f64], qd: &mut [f64], dt: f64) {
+    let cmd = &c.output().commands;
+    for (&j, &v) in c.resolver().arm_joints().iter().zip(&cmd.joint_velocities) {
+        qd[j] = v;
+        q[j] += v * dt;
+    }
+}
+
+#[test]
+fn shipped_setups_load_and_run_a_quiet_cycle() {
+    for robot in ["tomm", "planar7"] {
+        let mut c = controller(robot);
+        let nv = c.config().model.nv();
+        let q = if c.config().setup.posture.is_empty() { vec![0.0; nv] } else { c.config().setup.posture.clone() };
+        let cells = vec![CellReading::default(); c.config().layout.num_cells()];
+        let out = c.update(&ControllerInput { t_s: 0.0, dt_s: 0.008, q: &q, qd: &vec![0.0; nv], cells: &cells, scan: &[] });
+        assert_eq!(out.fault, None, "{robot}");
+        assert_eq!(out.mode, Mode::Avoidance, "{robot}");
+        assert!(out.signals.goal_error_m.is_nan(), "no goal: NaN goal error");
+        assert!(out.commands.joint_velocities.iter().all(|v| v.abs() < 1e-6), "{robot}: at rest without tasks: {:?}", out.commands);
+    }
+}
+
+#[test]
+fn planar7_reaches_its_goal_through_the_whole_chain() {
+    let mut c = controller("planar7");
+    let mut q = c.config().setup.posture.clone();
+    let mut qd = vec![0.0; 7];
+    let cells = vec![CellReading::default(); c.config().layout.num_cells()];
+    let goal = Vector3::new(0.9, 0.8, 0.0);
+    c.set_goal(Some(Isometry3::from_parts(Translation3::from(goal), UnitQuaternion::identity()))).unwrap();
+    let dt = 0.008;
+    let mut first_error = None;
+    for k in 0..1500 {
+        let out = c.update(&ControllerInput { t_s: k as f64 * dt, dt_s: dt, q: &q, qd: &qd, cells: &cells, scan: &[] });
+        assert_eq!(out.fault, None);
+        first_error.get_or_insert(out.signals.goal_error_m);
+        follow(&c, &mut q, &mut qd, dt);
+    }
+    let e = c.output().signals.goal_error_m;
+    assert!(first_error.unwrap() > 0.3, "the goal starts far away");
+    assert!(e < 0.01, "goal error after 12 s: {e} m");
+}
+
+#[test]
+fn bad_inputs_make_safe_stop_steps() {
+    let mut c = controller("planar7");
+    let q = c.config().setup.posture.clone();
+    let cells = vec![CellReading::default(); c.config().layout.num_cells()];
+    c.set_goal(Some(Isometry3::translation(0.0, 1.2, 0.0))).unwrap();
+    let mut qd = vec![0.0; 7];
+    let dt = 0.008;
+    for k in 0..50 {
+        c.update(&ControllerInput { t_s: k as f64 * dt, dt_s: dt, q: &q, qd: &qd, cells: &cells, scan: &[] });
+    }
+    let moving: f64 = c.output().commands.joint_velocities.iter().map(|v| v.abs()).sum();
+    assert!(moving > 0.05, "moving toward the goal");
+    qd[3] = f64::NAN;
+    let inputs = [
+        (Fault::NonFinite { input: "qd", index: 3 }, ControllerInput { t_s: 1.0, dt_s: dt, q: &q, qd: &qd, cells: &cells, scan: &[] }),
+        (Fault::Length { input: "q", expected: 7, got: 6 }, ControllerInput { t_s: 1.0, dt_s: dt, q: &q[..6], qd: &q, cells: &cells, scan: &[] }),
+        (Fault::Length { input: "cells", expected: cells.len(), got: 3 }, ControllerInput { t_s: 1.0, dt_s: dt, q: &q, qd: &q, cells: &cells[..3], scan: &[] }),
+        (Fault::BadTimeStep, ControllerInput { t_s: 1.0, dt_s: 0.0, q: &q, qd: &q, cells: &cells, scan: &[] }),
+    ];
+    for (fault, input) in &inputs {
+        let before: Vec<f64> = c.output().commands.joint_velocities.clone();
+        let out = c.update(input);
+        assert_eq!(out.fault, Some(*fault));
+        for (a, b) in before.iter().zip(&out.commands.joint_velocities) {
+            assert!(b.abs() <= a.abs() + 1e-12, "a safe-stop step never speeds up: {a} -> {b}");
+        }
+    }
+    assert!(c.set_goal(Some(Isometry3::translation(f64::NAN, 0.0, 0.0))).is_err());
+    assert!(c.set_hand_force_reference(f64::NAN).is_err());
+}
+
+#[test]
+fn setup_errors_name_file_and_key() {
+    let e = setup_error("tomm", "end_effector: right_hand", "end_effector: right_hnad");
+    assert!(e.contains("end_effector") && e.contains("right_hnad") && e.contains(".yaml"), "{e}");
+    let e = setup_error("tomm", "hand_patches: [12]", "hand_patches: [99]");
+    assert!(e.contains("hand_patches[0]") && e.contains("99"), "{e}");
+    let e = setup_error("planar7", "posture: [0.6, -0.5,", "posture: [");
+    assert!(e.contains("posture") && e.contains("5 values"), "{e}");
+    let e = setup_error("planar7", "damping: 1.0e-3", "damping: -1.0");
+    assert!(e.contains("inverse.") && e.contains("damping"), "{e}");
+    let e = setup_error("tomm", "end_effector:", "end_efector:");
+    assert!(e.contains("end_efector"), "unknown keys are errors: {e}");
+}
+
+#[test]
+fn task_names_map_to_kinds() {
+    for (name, kind) in TaskKind::ALL {
+        assert_eq!(TaskKind::from_name(name), Some(kind));
+    }
+    assert_eq!(TaskKind::from_name("levitate"), None);
+    assert!(!TaskKind::Posture.is_level() && TaskKind::Goal.is_level());
+}

@@ -1,0 +1,141 @@
+//! The skin aggregator's work, without the node around it: cells in, patch wrenches and markers
+//! out (paper 003 eq. 6-8 through `skin_core::skin::aggregate`).
+use r2r::skin_msgs::msg::{PatchWrenchArray, SkinCellArray};
+use r2r::visualization_msgs::msg::MarkerArray;
+use skin_core::skin::aggregate::{aggregate_patches, FusionParams, PatchWrench};
+use skin_core::skin::layout::ResolvedLayout;
+
+use crate::convert::{write_patch_array, CellBuffer, Issue, IssueCounts};
+use crate::markers::SkinMarkers;
+
+/// `ros2 param describe` texts of the skin model parameters (`skin_core::skin::params::SkinParams`,
+/// `config/skin_model.yaml`), by dotted key.
+pub const SKIN_PARAM_DESCRIPTIONS: &[(&str, &str)] = &[
+    ("proximity.range_m", "Proximity sensing range [m]: signal 0 from here on (paper 000 eq. 3 d_range)"),
+    ("proximity.decay_m", "Decay length of the proximity characteristic p(d) [m]"),
+    ("force.scale_n", "Scale of the force characteristic f(F) [N]"),
+    ("force.max_n", "Force at which the force signal saturates at 1 [N]"),
+    ("fusion.weight_force", "w of paper 003 eq. 6 in [0, 1]: cell virtual force sF = w f + (1 - w) p (0: proximity only, 1: force only)"),
+    ("fusion.activity_threshold", "A cell is active (enters the patch wrench, eq. 7-8) when sF exceeds this, in [0, 1)"),
+    ("fusion.force_reduction", "How a cell's three force sensors make one signal: mean | max"),
+    ("repulsion.gain_n_per_m", "Paper 000 eq. 3 repulsion gain K [N/m]"),
+    ("repulsion.range_m", "Paper 000 eq. 3 repulsion range [m], <= proximity.range_m"),
+    ("repulsion.max_force_n", "Paper 003 eq. 16 largest repulsive force [N]"),
+    ("repulsion.decay_m", "Paper 003 eq. 16 decay length [m]"),
+];
+
+/// Cells to patch wrenches and markers for one layout; every buffer is kept between messages.
+#[derive(Debug, Clone)]
+pub struct Aggregator {
+    layout: ResolvedLayout,
+    cells: CellBuffer,
+    wrenches: Vec<PatchWrench>,
+    markers: SkinMarkers,
+    patches_msg: PatchWrenchArray,
+    markers_msg: MarkerArray,
+}
+
+impl Aggregator {
+    /// An aggregator for `layout`, every cell reading zero.
+    pub fn new(layout: ResolvedLayout) -> Self {
+        Aggregator {
+            cells: CellBuffer::new(&layout),
+            markers: SkinMarkers::new(&layout),
+            wrenches: Vec::with_capacity(layout.patches().len()),
+            layout,
+            patches_msg: PatchWrenchArray::default(),
+            markers_msg: MarkerArray::default(),
+        }
+    }
+
+    /// The layout.
+    pub fn layout(&self) -> &ResolvedLayout {
+        &self.layout
+    }
+
+    /// Bad input counted since the start.
+    pub fn issues(&self) -> &IssueCounts {
+        self.cells.issues()
+    }
+
+    /// Takes one `SkinCellArray` (issues go to `report`) and returns the `/skin/patches` message
+    /// (every patch, stamped like the cells) and the `/skin/markers` update (empty when RViz is
+    /// already up to date).
+    pub fn process(
+        &mut self,
+        msg: &SkinCellArray,
+        fusion: &FusionParams,
+        report: impl FnMut(&Issue),
+    ) -> (&PatchWrenchArray, &MarkerArray) {
+        self.cells.update(&self.layout, msg, report);
+        let readings = self.cells.readings();
+        aggregate_patches(&self.layout, readings, fusion, &mut self.wrenches)
+            .expect("the cell buffer has one reading per layout cell");
+        let stamp = &msg.header.stamp;
+        write_patch_array(&self.layout, &self.wrenches, stamp, &mut self.patches_msg);
+        self.markers.update(
+            &self.layout,
+            readings,
+            fusion,
+            &self.wrenches,
+            stamp,
+            &mut self.markers_msg,
+        );
+        (&self.patches_msg, &self.markers_msg)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ros_params::flatten;
+    use r2r::skin_msgs::msg::SkinCell;
+    use skin_core::model::RobotModel;
+    use skin_core::skin::layout::SkinLayout;
+    use skin_core::skin::params::SkinParams;
+    use std::path::{Path, PathBuf};
+
+    fn repo(rel: &str) -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
+    }
+
+    #[test]
+    fn every_skin_parameter_has_a_description() {
+        let p = SkinParams::load(&repo("config/skin_model.yaml")).unwrap();
+        let keys: Vec<String> = flatten(&p).unwrap().keys().cloned().collect();
+        let mut described: Vec<String> = SKIN_PARAM_DESCRIPTIONS
+            .iter()
+            .map(|(k, _)| k.to_string())
+            .collect();
+        described.sort();
+        assert_eq!(keys, described);
+    }
+
+    #[test]
+    fn tomm_cells_to_patches() {
+        let model = RobotModel::from_urdf_file(&repo("urdf/tomm.urdf")).unwrap();
+        let layout = SkinLayout::load(&repo("config/skin/tomm.yaml"))
+            .unwrap()
+            .resolve(&model)
+            .unwrap();
+        let fusion = SkinParams::load(&repo("config/skin_model.yaml"))
+            .unwrap()
+            .fusion;
+        let first = layout.cells()[0].id;
+        let mut agg = Aggregator::new(layout);
+        let msg = SkinCellArray {
+            cells: vec![SkinCell {
+                cell_id: first,
+                force: vec![0.5; 3],
+                proximity: 0.5,
+                ..Default::default()
+            }],
+            ..Default::default()
+        };
+        let (patches, markers) = agg.process(&msg, &fusion, |i| panic!("{i}"));
+        assert_eq!(patches.patches.len(), 12);
+        assert_eq!(patches.patches[0].active_cells, 1);
+        assert_eq!(markers.markers.len(), 3);
+        assert_eq!(agg.issues().total(), 0);
+    }
+}

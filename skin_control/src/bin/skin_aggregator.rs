@@ -1,0 +1,239 @@
+//! `skin_aggregator`: skin cells in, patch wrenches and RViz markers out (paper 003 eq. 6-8).
+//! The node's wiring only; the work is in `skin_control::aggregator`. See docs/ros.md.
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context as _, Result};
+use clap::Parser;
+use futures::{executor::LocalPool, task::LocalSpawnExt, StreamExt};
+use r2r::skin_msgs::msg::{PatchWrenchArray, SkinCellArray};
+use r2r::visualization_msgs::msg::MarkerArray;
+use r2r::{ParameterValue, RosParams};
+use skin_control::aggregator::{Aggregator, SKIN_PARAM_DESCRIPTIONS};
+use skin_control::convert::IssueKind;
+use skin_control::ros_params::StructParams;
+use skin_control::{markers, paths, qos, shutdown};
+use skin_core::model::RobotModel;
+use skin_core::skin::layout::{ResolvedLayout, SkinLayout};
+use skin_core::skin::params::SkinParams;
+
+const NODE: &str = "skin_aggregator";
+const CELLS_TOPIC: &str = "/skin/cells";
+const PATCHES_TOPIC: &str = "/skin/patches";
+const MARKERS_TOPIC: &str = "/skin/markers";
+
+/// Aggregates skin cells (/skin/cells, skin_msgs/SkinCellArray) into patch wrenches
+/// (/skin/patches, skin_msgs/PatchWrenchArray) and RViz markers (/skin/markers).
+///
+/// Files are given by these options, else by the ROS parameters urdf_file, layout_file,
+/// skin_model_file (`--ros-args -p urdf_file:=... ` or `--params-file config/ros/skin_aggregator.yaml`),
+/// else the defaults below. Relative paths are tried against the working directory, the installed
+/// package's share directory, then the source repository. The skin model file gives the initial
+/// values of the settable parameters (fusion.weight_force, ...), which the node's ROS parameters
+/// override.
+#[derive(Parser)]
+#[command(
+    version,
+    after_help = "ROS arguments go after --ros-args, e.g.\n  skin_aggregator --ros-args --params-file config/ros/skin_aggregator.yaml -p fusion.weight_force:=0.8"
+)]
+struct Args {
+    /// Robot URDF [default: urdf/tomm.urdf].
+    #[arg(long, value_name = "FILE")]
+    urdf: Option<String>,
+    /// Skin layout [default: config/skin/tomm.yaml].
+    #[arg(long, value_name = "FILE")]
+    layout: Option<String>,
+    /// Skin model parameter file (initial parameter values) [default: config/skin_model.yaml].
+    #[arg(long, value_name = "FILE")]
+    skin_model: Option<String>,
+}
+
+/// A start-up file: the command-line option, else the ROS parameter, else the default.
+fn file_setting(
+    node: &r2r::Node,
+    option: Option<String>,
+    key: &str,
+    default: &str,
+) -> Result<String> {
+    let param: Option<String> = node
+        .get_parameter(key)
+        .with_context(|| format!("ROS parameter `{key}`"))?;
+    Ok(option.or(param).unwrap_or_else(|| default.to_string()))
+}
+
+fn resolve(setting: &str, what: &str) -> Result<std::path::PathBuf> {
+    paths::resolve(setting).map_err(|e| anyhow::anyhow!("{what}: {e}"))
+}
+
+struct Setup {
+    layout: ResolvedLayout,
+    params: StructParams<SkinParams>,
+}
+
+fn setup(node: &r2r::Node, args: Args) -> Result<Setup> {
+    let urdf = file_setting(node, args.urdf, "urdf_file", "urdf/tomm.urdf")?;
+    let layout_file = file_setting(node, args.layout, "layout_file", "config/skin/tomm.yaml")?;
+    let skin_model = file_setting(
+        node,
+        args.skin_model,
+        "skin_model_file",
+        "config/skin_model.yaml",
+    )?;
+    let model = RobotModel::from_urdf_file(&resolve(&urdf, "urdf_file")?)?;
+    let layout = SkinLayout::load(&resolve(&layout_file, "layout_file")?)?.resolve(&model)?;
+    let defaults = SkinParams::load(&resolve(&skin_model, "skin_model_file")?)?;
+    let mut params = StructParams::new(
+        defaults,
+        |p| p.validate().map_err(|e| e.to_string()),
+        SKIN_PARAM_DESCRIPTIONS,
+    )?
+    .with_read_only(
+        "urdf_file",
+        ParameterValue::String(urdf),
+        "Robot URDF (read at start)",
+    )
+    .with_read_only(
+        "layout_file",
+        ParameterValue::String(layout_file),
+        "Skin layout (read at start)",
+    )
+    .with_read_only(
+        "skin_model_file",
+        ParameterValue::String(skin_model),
+        "Skin model file: initial values of the other parameters (read at start)",
+    );
+    // Here rather than inside r2r's registration: this error says where the value came from.
+    params
+        .apply_overrides(&node.params.lock().unwrap())
+        .context("ROS parameter overrides (--ros-args -p / --params-file)")?;
+    Ok(Setup { layout, params })
+}
+
+/// Durations of one stage over all messages, for the shutdown summary.
+#[derive(Default)]
+struct Timing {
+    count: u64,
+    total: Duration,
+    max: Duration,
+}
+
+impl Timing {
+    fn add(&mut self, d: Duration) {
+        self.count += 1;
+        self.total += d;
+        self.max = self.max.max(d);
+    }
+}
+
+impl std::fmt::Display for Timing {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mean = self
+            .total
+            .checked_div(self.count.max(1) as u32)
+            .unwrap_or_default();
+        write!(f, "mean {mean:?}, max {:?}", self.max)
+    }
+}
+
+fn main() -> Result<()> {
+    // clap sees the arguments before --ros-args; rcl parses the rest.
+    let args = Args::parse_from(std::env::args().take_while(|a| a != "--ros-args"));
+    shutdown::install().context("installing the SIGINT/SIGTERM handler")?;
+    let ctx = r2r::Context::create()?;
+    let mut node = r2r::Node::create(ctx, NODE, "")?;
+    let logger = node.logger().to_string();
+    let Setup { layout, params } = setup(&node, args)?;
+    let params = Arc::new(Mutex::new(params));
+    let served: Arc<Mutex<dyn RosParams + Send>> = params.clone();
+    let (param_services, mut param_changes) = node
+        .make_derived_parameter_handler(served)
+        .context("declaring the parameters")?;
+    let mut cells = node.subscribe::<SkinCellArray>(CELLS_TOPIC, qos::stream())?;
+    let patches_pub = node.create_publisher::<PatchWrenchArray>(PATCHES_TOPIC, qos::stream())?;
+    let markers_pub = node.create_publisher::<MarkerArray>(MARKERS_TOPIC, qos::stream())?;
+    r2r::log_info!(
+        &logger,
+        "{} -> {}, {}: layout {} ({} patches, {} cells)",
+        CELLS_TOPIC,
+        PATCHES_TOPIC,
+        MARKERS_TOPIC,
+        layout.source(),
+        layout.patches().len(),
+        layout.num_cells()
+    );
+
+    let mut pool = LocalPool::new();
+    let spawner = pool.spawner();
+    spawner.spawn_local(param_services)?;
+    let log = logger.clone();
+    spawner.spawn_local(async move {
+        while let Some((name, value)) = param_changes.next().await {
+            r2r::log_info!(&log, "parameter {name} set to {value:?}");
+        }
+    })?;
+    let aggregator = Arc::new(Mutex::new(Aggregator::new(layout)));
+    // Per message: the aggregation (cells in, both messages built) and the whole cycle (with
+    // publishing).
+    let timing = Arc::new(Mutex::new((Timing::default(), Timing::default())));
+    let (agg, time, log) = (aggregator.clone(), timing.clone(), logger.clone());
+    let markers_out = markers_pub.clone();
+    spawner.spawn_local(async move {
+        let mut logged = [false; IssueKind::ALL.len()];
+        let mut publish_failed = false;
+        while let Some(msg) = cells.next().await {
+            let start = Instant::now();
+            let fusion = params.lock().unwrap().value().fusion;
+            let mut agg = agg.lock().unwrap();
+            let (patches, markers) = agg.process(&msg, &fusion, |issue| {
+                // Each kind once, with an example; the counts go into the shutdown summary.
+                if !std::mem::replace(&mut logged[issue.kind as usize], true) {
+                    r2r::log_warn!(
+                        &log,
+                        "{CELLS_TOPIC}: {issue} (further ones are counted, totals at shutdown)"
+                    );
+                }
+            });
+            let built = start.elapsed();
+            let sent = patches_pub
+                .publish(patches)
+                .map_err(|e| format!("{PATCHES_TOPIC}: {e}"))
+                .and_then(|_| {
+                    if markers.markers.is_empty() {
+                        Ok(())
+                    } else {
+                        markers_out
+                            .publish(markers)
+                            .map_err(|e| format!("{MARKERS_TOPIC}: {e}"))
+                    }
+                });
+            if let Err(e) = sent {
+                if !std::mem::replace(&mut publish_failed, true) {
+                    r2r::log_error!(&log, "publishing failed: {e}");
+                }
+            }
+            let mut time = time.lock().unwrap();
+            time.0.add(built);
+            time.1.add(start.elapsed());
+        }
+    })?;
+
+    while !shutdown::requested() {
+        node.spin_once(Duration::from_millis(20));
+        pool.run_until_stalled();
+    }
+    // Leave RViz clean: the markers would otherwise stay on screen.
+    let clear = MarkerArray {
+        markers: vec![markers::delete_all()],
+    };
+    if let Err(e) = markers_pub.publish(&clear) {
+        r2r::log_warn!(&logger, "{MARKERS_TOPIC}: clearing the markers failed: {e}");
+    }
+    let issues = *aggregator.lock().unwrap().issues();
+    let (aggregation, cycle) = &*timing.lock().unwrap();
+    r2r::log_info!(
+        &logger,
+        "stopping after {} messages: aggregation {aggregation}, with publishing {cycle}; bad input: {issues}",
+        cycle.count
+    );
+    Ok(())
+}

@@ -11,7 +11,7 @@ use crate::resolver::{Commands, Resolver};
 use crate::skin::aggregate::{aggregate_patches, FusionParams, PatchWrench};
 use crate::skin::transforms::{patch_poses_world, patch_wrench_world, sum_patch_forces_in_frame};
 use crate::supervisor::blend::chi;
-use crate::supervisor::{Arrangement, Phase, PhaseRefused, Supervisor, SupervisorInput, TorqueBlender};
+use crate::supervisor::{Arrangement, Imposed, Phase, PhaseRefused, Supervisor, SupervisorInput, TorqueBlender};
 use crate::tasks::rows_times_qd;
 
 /// Maps a stage's error to [`Fault::Stage`] (the error's text would allocate).
@@ -150,19 +150,28 @@ impl Controller {
         self.goal.as_ref()
     }
 
-    /// Sets the desired fused hand signal `f_c,d` of paper 003 eq. (9) (clamped to [0, 1]; NaN
-    /// is refused).
+    /// Sets the desired fused hand signal `f_c,d` of paper 003 eq. (9): the hand patches' summed
+    /// virtual force along the hand's z axis (eq. 7: a sum over the active cells, so up to the
+    /// number of hand cells), clamped to `[0, hand cells]`; NaN is refused.
     pub fn set_hand_force_reference(&mut self, signal: f64) -> Result<(), Fault> {
         if signal.is_nan() {
             return Err(Fault::NonFinite { input: "hand force reference", index: 0 });
         }
-        self.tasks.set_hand_force_reference(signal.clamp(0.0, 1.0));
+        let layout = &self.config.layout;
+        let hand_cells: usize = layout.patches().iter().zip(&self.hand_patches).filter(|(_, &h)| h).map(|(p, _)| p.cells.len()).sum();
+        self.tasks.set_hand_force_reference(signal.clamp(0.0, hand_cells as f64));
         Ok(())
     }
 
     /// Requests a paper 003 phase (effective at the next update).
     pub fn request_phase(&mut self, phase: Phase) -> Result<(), PhaseRefused> {
         self.supervisor.request_phase(phase)
+    }
+
+    /// Follows an arrangement decided elsewhere (the `priority_supervisor` node) from now on
+    /// instead of the controller's own supervisor rules ([`Supervisor::impose`]).
+    pub fn impose_arrangement(&mut self, a: Imposed) -> Result<(), PhaseRefused> {
+        self.supervisor.impose(a)
     }
 
     /// The supervisor (mode, arrangement, transition log).

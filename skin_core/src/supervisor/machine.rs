@@ -6,7 +6,7 @@ use super::log::TransitionLog;
 use super::params::{
     DwellTimes, FusionShift, ParamError, Policy, SensingRange, SupervisorParams, Thresholds,
 };
-use super::types::{Arrangement, Cause, Mode, Phase, PhaseRefused, SupervisorInput, Transition};
+use super::types::{Arrangement, Cause, Imposed, Mode, Phase, PhaseRefused, SupervisorInput, Transition};
 
 /// A condition that must hold for a dwell time, with a hysteresis between the condition that
 /// starts the timer (`set`) and the weaker one that keeps it running (`keep`).
@@ -56,6 +56,9 @@ pub struct Supervisor {
     last_t: f64,
     last_transition: Option<Transition>,
     log: TransitionLog,
+    /// Following another supervisor ([`Supervisor::impose`]): its own rules are off.
+    follower: bool,
+    imposed: Option<Imposed>,
 }
 
 impl Supervisor {
@@ -102,6 +105,8 @@ impl Supervisor {
             last_t: t0,
             last_transition: None,
             log: TransitionLog::new(params.log_capacity),
+            follower: false,
+            imposed: None,
         })
     }
 
@@ -117,11 +122,17 @@ impl Supervisor {
         let dt = (t - self.last_t).max(0.0);
         self.last_t = t;
         self.last_transition = None;
-        match self.policy {
-            Policy::IntentionalContact => self.step_table_i(t, input),
-            Policy::Phases => self.step_phases(t),
+        if self.follower {
+            if let Some(a) = self.imposed.take() {
+                self.follow(t, a);
+            }
+        } else {
+            match self.policy {
+                Policy::IntentionalContact => self.step_table_i(t, input),
+                Policy::Phases => self.step_phases(t),
+            }
+            self.ramp_range(dt);
         }
-        self.ramp_range(dt);
         self.arrangement.fusion_weight = self.weight.at(t);
         &self.arrangement
     }
@@ -140,6 +151,42 @@ impl Supervisor {
                          conditions only; configure `policy: phases` to request phases",
             }),
         }
+    }
+
+    /// Makes this supervisor follow `a`, decided by another one with the same configuration
+    /// (the ROS graph: `priority_supervisor` decides, `task_controller` follows). From the first
+    /// call on, its own rules are off; each imposed arrangement takes effect at the next
+    /// [`Self::update`] with the deciding supervisor's switch time (so the torque blend and the
+    /// fusion weight shift run on the same clock) and its sensing range. Invalid values are
+    /// refused and change nothing.
+    pub fn impose(&mut self, a: Imposed) -> Result<(), PhaseRefused> {
+        let valid = a.switch_time_s.is_finite()
+            && a.sensing_range_m.is_finite()
+            && a.sensing_range_m >= 0.0
+            && (0.0..=1.0).contains(&a.fusion_weight_target);
+        if !valid {
+            return Err(PhaseRefused {
+                reason: "imposed arrangement: switch time and sensing range must be finite, the range >= 0 and the fusion weight in [0, 1]",
+            });
+        }
+        self.follower = true;
+        self.imposed = Some(a);
+        Ok(())
+    }
+
+    /// Applies an imposed arrangement (see [`Self::impose`]).
+    fn follow(&mut self, t: f64, a: Imposed) {
+        let current = &self.arrangement;
+        let new_switch = a.mode != current.mode || a.switch_time_s.to_bits() != current.switch_time_s.to_bits();
+        if a.fusion_weight_target != self.weight.target() {
+            let now = self.weight.at(t);
+            self.weight = WeightShift::new(now, a.fusion_weight_target, a.switch_time_s, self.fusion.duration_s, self.fusion.gain);
+            self.arrangement.fusion_weight_target = a.fusion_weight_target;
+        }
+        if new_switch {
+            self.switch(a.switch_time_s, a.mode, Cause::Imposed);
+        }
+        self.arrangement.sensing_range_m = a.sensing_range_m;
     }
 
     /// The active arrangement.

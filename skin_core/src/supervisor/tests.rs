@@ -665,3 +665,41 @@ fn unknown_key_and_bad_policy_are_parse_errors() {
     let e = load_err("policy: intentional_contact", "policy: intentional");
     assert!(e.starts_with("bad.yaml:"), "{e}");
 }
+
+/// A follower reproduces the decider's arrangement, switch times, range and weight exactly.
+#[test]
+fn follower_reproduces_the_deciding_supervisor() {
+    for params in [params(), phases_params()] {
+        let mut decider = Supervisor::new(&params, 0.0).unwrap();
+        let mut follower = Supervisor::new(&params, 0.0).unwrap();
+        let mut t = 0.0;
+        let mut rng = Rng(3);
+        for k in 0..3000 {
+            t += 0.008;
+            if k == 500 {
+                let _ = decider.request_phase(Phase::Contact);
+            }
+            let fc = if (1500..1800).contains(&k) { 8.0 } else { 0.0 };
+            let u = input(0.002 * rng.next().abs(), 2.0, fc, 0.3);
+            let a = decider.update(t, &u).clone();
+            follower
+                .impose(Imposed {
+                    mode: a.mode,
+                    switch_time_s: a.switch_time_s,
+                    sensing_range_m: a.sensing_range_m,
+                    fusion_weight_target: a.fusion_weight_target,
+                })
+                .unwrap();
+            let f = follower.update(t, &SupervisorInput::default());
+            assert_eq!(f.mode, a.mode, "cycle {k}");
+            assert_eq!(f.task_order(), a.task_order());
+            assert_eq!(f.switch_time_s.to_bits(), a.switch_time_s.to_bits());
+            assert_eq!(f.sensing_range_m, a.sensing_range_m);
+            assert!((f.fusion_weight - a.fusion_weight).abs() < 1e-12, "cycle {k}: w {} vs {}", f.fusion_weight, a.fusion_weight);
+        }
+        assert!(decider.log().total() >= 1, "{:?}: something switched", params.policy);
+    }
+    let mut s = Supervisor::new(&params(), 0.0).unwrap();
+    let bad = Imposed { mode: Mode::Avoidance, switch_time_s: f64::NAN, sensing_range_m: 0.1, fusion_weight_target: 0.0 };
+    assert!(s.impose(bad).is_err());
+}

@@ -98,6 +98,23 @@ pub enum Cause {
     InvalidInput,
     /// A paper 003 phase request.
     PhaseRequest,
+    /// Decided by another supervisor (the `priority_supervisor` node), see
+    /// [`super::Supervisor::impose`].
+    Imposed,
+}
+
+/// An arrangement decided by another supervisor with the same configuration: what
+/// `Arrangement.msg` carries.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Imposed {
+    /// The mode (its task order comes from this supervisor's configuration).
+    pub mode: Mode,
+    /// `t_t` of the switch at the deciding supervisor [s].
+    pub switch_time_s: f64,
+    /// `d_range` [m].
+    pub sensing_range_m: f64,
+    /// The fusion weight `w` the deciding supervisor shifts to.
+    pub fusion_weight_target: f64,
 }
 
 /// One arrangement switch.

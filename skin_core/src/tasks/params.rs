@@ -51,7 +51,8 @@ pub struct HandForceParams {
     pub k_distance_n_per_m: f64,
     /// `D_1` \[N s/m\].
     pub d_n_s_per_m: f64,
-    /// Desired fused contact signal `f_c,d` (contact phase, Table 1) in \[0, 1\].
+    /// Desired fused contact signal `f_c,d` (contact phase, Table 1), ≥ 0: the hand patch's
+    /// summed virtual force (eq. 7 sums the active cells' signals, so it can exceed 1).
     pub force_signal_desired: f64,
     /// Desired distance `d_p,d` \[m\] (approach phase, Table 1).
     pub distance_desired_m: f64,
@@ -168,7 +169,7 @@ impl TaskParams {
         nonneg("hand_force.", "k_force_n_per_signal", h.k_force_n_per_signal)?;
         nonneg("hand_force.", "k_distance_n_per_m", h.k_distance_n_per_m)?;
         nonneg("hand_force.", "d_n_s_per_m", h.d_n_s_per_m)?;
-        InvalidParam::in_range("hand_force.", "force_signal_desired", h.force_signal_desired, 0.0, 1.0, "must be in [0, 1]")?;
+        InvalidParam::in_range("hand_force.", "force_signal_desired", h.force_signal_desired, 0.0, f64::MAX, "must be finite and >= 0")?;
         nonneg("hand_force.", "distance_desired_m", h.distance_desired_m)?;
         self.wrist.validate("wrist.")?;
         self.tactile_guidance.validate("tactile_guidance.")?;

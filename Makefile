@@ -9,10 +9,11 @@ MSGS_STAMP := $(DEPS)/ros/install/share/skin_msgs/package.xml
 MSG_SRCS := $(wildcard skin_msgs/msg/*.msg skin_msgs/srv/*.srv) skin_msgs/CMakeLists.txt skin_msgs/package.xml
 CARGO_PROFILE ?= dev
 
-.PHONY: help bootstrap msgs build test test-rust test-integration demo bench clean
+.PHONY: help bootstrap msgs build test test-rust test-integration run demo bench clean
 
 help:
-	@echo "make demo   bootstrap, build, run the main job (see README.md)"
+	@echo "make demo   bootstrap, build, run the main job: the intentional_contact scenario (see README.md)"
+	@echo "make run SCENE=<name>  run one scenario (skin_sim list), outputs in out/<name>/"
 	@echo "make test   bootstrap, build, run every test suite (cargo tests + test/ integration tests)"
 	@echo "make bench  run the benchmarks; figures in out/bench/summary.json"
 	@echo "make clean  remove build outputs (keeps .deps; rm -rf .deps for a full reset)"
@@ -46,6 +47,12 @@ test-integration: build
 
 test: test-rust test-integration
 	@echo "[make] all test suites passed"
+
+# One closed-loop scenario (skin_sim list names them); metrics.json and summary.txt in out/$(SCENE)/.
+# The debug profile is fast enough (opt-level 1): 20-90 s scenes run in 1-5 s.
+SCENE ?= intentional_contact
+run: build
+	@$(ENV) target/debug/skin_sim run $(SCENE) --out out/$(SCENE)
 
 demo: build
 	@$(ENV) scripts/demo

@@ -1,2 +1,38 @@
 //! `skin_sim`: MuJoCo worlds for skin_control, built from our URDFs and scene files.
+//!
+//! - [`scene`]: scene files (`config/scenes/*.yaml`, documented in `docs/scenes.md`), validated
+//!   with errors that name the file and the key;
+//! - [`mjcf`]: the MJCF generated from the robot model and the scene;
+//! - [`world`]: the running simulation, the robot's velocity interface and its state;
+//! - [`skin_sensor`] and [`lidar`]: the simulated sensors;
+//! - [`noise`]: seeded Gaussian noise;
+//! - [`closed_loop`]: the world and a skin_core `Controller` in lockstep, with the scene's
+//!   [`schedule`] (goals, force references via [`hand_force`], phases), the [`interaction`]
+//!   periods and the physical contact forces of [`probe`], recorded per cycle in [`record`];
+//! - [`scenario`], [`runner`], [`metrics`], [`outcome`], [`report`]: the named scenarios of the
+//!   papers, a run from scene to report, `metrics.json`, the outcome checks, the summary.
 #![warn(missing_docs)]
+
+pub mod closed_loop;
+mod frames;
+pub mod hand_force;
+pub mod interaction;
+pub mod lidar;
+pub mod metrics;
+pub mod mjcf;
+pub mod noise;
+pub mod outcome;
+pub mod probe;
+pub mod record;
+pub mod report;
+pub mod runner;
+pub mod scenario;
+pub mod scene;
+pub mod schedule;
+pub mod skin_sensor;
+pub mod world;
+
+pub use scene::{Scene, SceneError};
+pub use world::{World, WorldError};
+pub mod bag;
+pub mod plot;

@@ -1,0 +1,402 @@
+//! Plain Rust mirrors of the ROS 2 messages the skin_control graph carries. Field order and types
+//! follow the `.msg` definitions exactly: the serde derive is the CDR layout.
+
+use serde::{Deserialize, Serialize};
+
+/// A message type that can be written to (and read from) a bag.
+pub trait RosMessage: Serialize + serde::de::DeserializeOwned {
+    /// Full type name as rosbag2 stores it, e.g. `sensor_msgs/msg/JointState`.
+    const TYPE_NAME: &'static str;
+}
+
+macro_rules! ros_type {
+    ($($ty:ident => $name:literal),* $(,)?) => {
+        $(impl RosMessage for $ty {
+            const TYPE_NAME: &'static str = $name;
+        })*
+    };
+}
+
+ros_type! {
+    Time => "builtin_interfaces/msg/Time",
+    Header => "std_msgs/msg/Header",
+    Clock => "rosgraph_msgs/msg/Clock",
+    JointState => "sensor_msgs/msg/JointState",
+    Odometry => "nav_msgs/msg/Odometry",
+    LaserScan => "sensor_msgs/msg/LaserScan",
+    Twist => "geometry_msgs/msg/Twist",
+    Float64MultiArray => "std_msgs/msg/Float64MultiArray",
+    SkinCellArray => "skin_msgs/msg/SkinCellArray",
+    PatchWrenchArray => "skin_msgs/msg/PatchWrenchArray",
+    Arrangement => "skin_msgs/msg/Arrangement",
+    ControllerState => "skin_msgs/msg/ControllerState",
+}
+
+/// `builtin_interfaces/Time`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Time {
+    /// Seconds.
+    pub sec: i32,
+    /// Nanoseconds within the second, `< 1e9`.
+    pub nanosec: u32,
+}
+
+impl Time {
+    /// The time `ns` nanoseconds after the epoch (sim time starts at 0).
+    pub fn from_nanos(ns: u64) -> Self {
+        // i32 seconds last until 2038 (wall clock) or 68 years of sim time.
+        Self {
+            sec: (ns / 1_000_000_000) as i32,
+            nanosec: (ns % 1_000_000_000) as u32,
+        }
+    }
+}
+
+/// `std_msgs/Header`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Header {
+    /// Stamp of the data.
+    pub stamp: Time,
+    /// Frame the data is expressed in.
+    pub frame_id: String,
+}
+
+/// `rosgraph_msgs/Clock`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Clock {
+    /// The current simulation time.
+    pub clock: Time,
+}
+
+/// `sensor_msgs/JointState`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct JointState {
+    /// Stamp of the sample.
+    pub header: Header,
+    /// Joint names.
+    pub name: Vec<String>,
+    /// Positions \[rad or m\].
+    pub position: Vec<f64>,
+    /// Velocities \[rad/s or m/s\].
+    pub velocity: Vec<f64>,
+    /// Efforts \[N m or N\].
+    pub effort: Vec<f64>,
+}
+
+/// `geometry_msgs/Vector3`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Vector3 {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+}
+
+/// `geometry_msgs/Point`: same layout as [`Vector3`], a position.
+pub type Point = Vector3;
+
+/// `geometry_msgs/Quaternion`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Quaternion {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+    /// w.
+    pub w: f64,
+}
+
+impl Default for Quaternion {
+    /// The identity rotation (the `.msg` default).
+    fn default() -> Self {
+        Self {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            w: 1.0,
+        }
+    }
+}
+
+/// `geometry_msgs/Pose`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Pose {
+    /// Position \[m\].
+    pub position: Point,
+    /// Orientation.
+    pub orientation: Quaternion,
+}
+
+/// `geometry_msgs/PoseWithCovariance`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PoseWithCovariance {
+    /// The pose.
+    pub pose: Pose,
+    /// Row-major 6x6 covariance (x, y, z, rotations about x, y, z).
+    #[serde(with = "fixed_array")]
+    pub covariance: [f64; 36],
+}
+
+/// `geometry_msgs/Twist`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Twist {
+    /// Linear velocity \[m/s\].
+    pub linear: Vector3,
+    /// Angular velocity \[rad/s\].
+    pub angular: Vector3,
+}
+
+/// `geometry_msgs/TwistWithCovariance`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TwistWithCovariance {
+    /// The twist.
+    pub twist: Twist,
+    /// Row-major 6x6 covariance.
+    #[serde(with = "fixed_array")]
+    pub covariance: [f64; 36],
+}
+
+// serde and Default stop at 32-element arrays: the covariances need these by hand.
+impl Default for PoseWithCovariance {
+    fn default() -> Self {
+        Self {
+            pose: Pose::default(),
+            covariance: [0.0; 36],
+        }
+    }
+}
+
+impl Default for TwistWithCovariance {
+    fn default() -> Self {
+        Self {
+            twist: Twist::default(),
+            covariance: [0.0; 36],
+        }
+    }
+}
+
+/// `geometry_msgs/Wrench`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Wrench {
+    /// Force \[N\].
+    pub force: Vector3,
+    /// Moment \[N m\].
+    pub torque: Vector3,
+}
+
+/// `nav_msgs/Odometry`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Odometry {
+    /// Stamp; `frame_id`: the frame of the pose (odom).
+    pub header: Header,
+    /// The frame of the twist (base).
+    pub child_frame_id: String,
+    /// Pose in `header.frame_id`.
+    pub pose: PoseWithCovariance,
+    /// Twist in `child_frame_id`.
+    pub twist: TwistWithCovariance,
+}
+
+/// `sensor_msgs/LaserScan`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct LaserScan {
+    /// Stamp of the first ray; frame of the scanner.
+    pub header: Header,
+    /// Angle of the first ray \[rad\].
+    pub angle_min: f32,
+    /// Angle of the last ray \[rad\].
+    pub angle_max: f32,
+    /// Angle between rays \[rad\].
+    pub angle_increment: f32,
+    /// Time between rays \[s\].
+    pub time_increment: f32,
+    /// Time between scans \[s\].
+    pub scan_time: f32,
+    /// Minimum valid range \[m\].
+    pub range_min: f32,
+    /// Maximum valid range \[m\].
+    pub range_max: f32,
+    /// Ranges \[m\].
+    pub ranges: Vec<f32>,
+    /// Intensities (device units), may be empty.
+    pub intensities: Vec<f32>,
+}
+
+/// `std_msgs/MultiArrayDimension`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct MultiArrayDimension {
+    /// Label of the dimension.
+    pub label: String,
+    /// Size of the dimension.
+    pub size: u32,
+    /// Stride of the dimension.
+    pub stride: u32,
+}
+
+/// `std_msgs/MultiArrayLayout`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct MultiArrayLayout {
+    /// Dimensions (empty: a plain vector).
+    pub dim: Vec<MultiArrayDimension>,
+    /// Padding elements at the front of `data`.
+    pub data_offset: u32,
+}
+
+/// `std_msgs/Float64MultiArray` (the forward velocity controller's command).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Float64MultiArray {
+    /// Layout of `data`.
+    pub layout: MultiArrayLayout,
+    /// The values.
+    pub data: Vec<f64>,
+}
+
+/// `skin_msgs/SkinCell`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct SkinCell {
+    /// Cell id from the skin layout.
+    pub cell_id: u32,
+    /// The three normalized force sensors, \[0, 1\].
+    pub force: [f32; 3],
+    /// Normalized proximity, \[0, 1\].
+    pub proximity: f32,
+    /// Acceleration in the cell frame \[m/s^2\].
+    pub acceleration: Vector3,
+    /// Temperature \[degC\].
+    pub temperature: f32,
+}
+
+/// `skin_msgs/SkinCellArray`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct SkinCellArray {
+    /// Sampling time.
+    pub header: Header,
+    /// The sampled cells.
+    pub cells: Vec<SkinCell>,
+}
+
+/// `skin_msgs/PatchWrench`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct PatchWrench {
+    /// Patch frame and the stamp of the cell data.
+    pub header: Header,
+    /// Patch id from the skin layout.
+    pub patch_id: u32,
+    /// URDF link the patch is mounted on.
+    pub link: String,
+    /// Patch wrench in the patch frame.
+    pub wrench: Wrench,
+    /// Centroid of the active cells in the patch frame \[m\].
+    pub centroid: Point,
+    /// Number of active cells.
+    pub active_cells: u32,
+    /// Largest normalized force signal, \[0, 1\].
+    pub max_force: f32,
+    /// Largest normalized proximity signal, \[0, 1\].
+    pub max_proximity: f32,
+}
+
+/// `skin_msgs/PatchWrenchArray`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct PatchWrenchArray {
+    /// Stamp of the cell data.
+    pub header: Header,
+    /// Every patch's wrench.
+    pub patches: Vec<PatchWrench>,
+}
+
+/// `skin_msgs/Arrangement`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Arrangement {
+    /// `MODE_*` constant of the `.msg`.
+    pub mode: u8,
+    /// Task names, highest priority first.
+    pub task_order: Vec<String>,
+    /// When the switch was triggered.
+    pub switch_time: Time,
+    /// Smoothing gain \[1/s\].
+    pub smoothing_gain: f64,
+    /// Proximity sensing range \[m\].
+    pub sensing_range: f64,
+    /// Fusion weight, \[0, 1\].
+    pub fusion_weight: f64,
+}
+
+/// `skin_msgs/TaskState`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TaskState {
+    /// Task name.
+    pub name: String,
+    /// Priority level, 1 = highest, 0 = inactive.
+    pub priority: u32,
+    /// Norm of the task error.
+    pub error_norm: f64,
+    /// Norm of the task's projected torque \[N m\].
+    pub torque_norm: f64,
+}
+
+/// `skin_msgs/ControllerState`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ControllerState {
+    /// Stamp of the control cycle.
+    pub header: Header,
+    /// Active arrangement mode.
+    pub mode: u8,
+    /// Blend factor chi, \[0, 1\].
+    pub blend: f64,
+    /// End-effector speed \[m/s\].
+    pub ee_speed: f64,
+    /// Proximity avoidance force norm \[N\].
+    pub avoidance_force: f64,
+    /// Largest contact force \[N\].
+    pub contact_force: f64,
+    /// Commanded torque norm \[N m\].
+    pub torque_norm: f64,
+    /// Distance to the goal \[m\], negative without goal.
+    pub goal_error: f64,
+    /// Per-task state.
+    pub tasks: Vec<TaskState>,
+}
+
+/// Serde for fixed arrays longer than serde's built-in 32 (the 6x6 covariances): a tuple, which
+/// CDR writes without a length, as the `.msg` `float64[36]` requires.
+mod fixed_array {
+    use serde::de::{Error, SeqAccess, Visitor};
+    use serde::ser::SerializeTuple;
+    use serde::{Deserializer, Serializer};
+    use std::fmt;
+
+    pub fn serialize<S: Serializer, const N: usize>(a: &[f64; N], s: S) -> Result<S::Ok, S::Error> {
+        let mut t = s.serialize_tuple(N)?;
+        for v in a {
+            t.serialize_element(v)?;
+        }
+        t.end()
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>, const N: usize>(
+        d: D,
+    ) -> Result<[f64; N], D::Error> {
+        struct ArrayVisitor<const N: usize>;
+        impl<'de, const N: usize> Visitor<'de> for ArrayVisitor<N> {
+            type Value = [f64; N];
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                write!(f, "{N} float64 values")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+                let mut out = [0.0; N];
+                for (i, v) in out.iter_mut().enumerate() {
+                    *v = seq
+                        .next_element()?
+                        .ok_or_else(|| A::Error::invalid_length(i, &self))?;
+                }
+                Ok(out)
+            }
+        }
+        d.deserialize_tuple(N, ArrayVisitor::<N>)
+    }
+}

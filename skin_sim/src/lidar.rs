@@ -1,0 +1,103 @@
+//! Simulated planar LIDAR: a fan of rays in the x-y plane of the scanner's frame, cast against
+//! objects and persons ([`SENSED_GROUPS`], never the robot), reported as 2-D points in the BASE
+//! frame (x forward, y left): the closest-obstacle points that base avoidance consumes (paper 003
+//! eq. (15)-(17)). Ranges get optional seeded Gaussian noise.
+
+use mujoco_rs::prelude::*;
+use mujoco_rs::wrappers::mj_model::traits::ModelType;
+use nalgebra::{Isometry3, Point3, Vector3};
+
+use crate::frames::FrameRef;
+use crate::mjcf::SENSED_GROUPS;
+use crate::noise::Noise;
+use crate::scene::Scene;
+use skin_core::resolver::BASE_JOINTS;
+
+/// Noise stream of the LIDAR (see [`Noise::new`]).
+const NOISE_STREAM: u64 = 2;
+
+/// The base LIDAR of a [`crate::world::World`].
+#[derive(Debug, Clone)]
+pub struct Lidar {
+    scanner: FrameRef,
+    /// Pose of the scanner frame in the base frame (both ride on the base body).
+    base_from_scanner: Isometry3<f64>,
+    /// Unit ray directions in the scanner frame.
+    directions: Vec<Vector3<f64>>,
+    range_m: f64,
+    noise_std_m: f64,
+    noise: Noise,
+    /// Per ray: the measured range \[m\], `f64::INFINITY` for no return.
+    ranges: Vec<f64>,
+    points: Vec<[f64; 2]>,
+}
+
+impl Lidar {
+    /// The LIDAR of `scene` (None when it has none) on the MuJoCo model generated from it.
+    pub(crate) fn new(scene: &Scene, mj: &MjModel) -> Option<Self> {
+        let spec = scene.spec.lidar.as_ref()?;
+        let model = &scene.model;
+        // Scene validation checked both frames.
+        let frame = model.frame_index(&spec.frame)?;
+        let base = model.joint_child_frame(model.joint_index(BASE_JOINTS[2])?);
+        let scanner = FrameRef::new(model, mj, frame);
+        let base_ref = FrameRef::new(model, mj, base);
+        let fov = spec.fov_deg.to_radians();
+        // A full circle has no end ray; a partial fan includes both of its edges.
+        let step = if spec.rays == 1 {
+            0.0
+        } else if spec.fov_deg >= 360.0 {
+            fov / spec.rays as f64
+        } else {
+            fov / (spec.rays - 1) as f64
+        };
+        let first = if spec.rays == 1 { 0.0 } else { -fov / 2.0 };
+        let directions = (0..spec.rays)
+            .map(|k| {
+                let a = first + step * k as f64;
+                Vector3::new(a.cos(), a.sin(), 0.0)
+            })
+            .collect();
+        Some(Lidar {
+            base_from_scanner: base_ref.placement.inverse() * scanner.placement,
+            scanner,
+            directions,
+            range_m: spec.range_m,
+            noise_std_m: spec.noise_std_m,
+            noise: Noise::new(scene.spec.seed, NOISE_STREAM),
+            ranges: vec![f64::INFINITY; spec.rays],
+            points: Vec::with_capacity(spec.rays),
+        })
+    }
+
+    /// The last scan's returns as points in the base frame \[m\] (rays without a return within
+    /// range are left out).
+    pub fn points(&self) -> &[[f64; 2]] {
+        &self.points
+    }
+
+    /// The last scan's range per ray \[m\], `f64::INFINITY` where nothing was within range.
+    pub fn ranges(&self) -> &[f64] {
+        &self.ranges
+    }
+
+    /// Casts every ray at the data's current kinematics.
+    pub(crate) fn scan<M: ModelType>(&mut self, data: &mut MjData<M>) {
+        let pose = self.scanner.world_pose(data);
+        let origin = pose.translation.vector;
+        self.points.clear();
+        for (k, dir) in self.directions.iter().enumerate() {
+            let d = pose.rotation * dir;
+            let (hit, dist) = data.ray(&origin.into(), &d.into(), Some(&SENSED_GROUPS), true, None, None);
+            let r = match hit {
+                Some(_) => dist + self.noise.gaussian(self.noise_std_m),
+                None => f64::INFINITY,
+            };
+            self.ranges[k] = if r <= self.range_m { r } else { f64::INFINITY };
+            if r <= self.range_m {
+                let p = self.base_from_scanner * Point3::from(dir * r);
+                self.points.push([p.x, p.y]);
+            }
+        }
+    }
+}

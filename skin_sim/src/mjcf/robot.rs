@@ -1,0 +1,197 @@
+//! The robot's part of the MJCF: one body per moving joint of the [`RobotModel`] (links joined by
+//! fixed joints are already merged there), its collision primitives and merged inertial, a joint
+//! and a velocity servo when the joint moves in the scene, none (welded at its fixed position)
+//! when it is frozen.
+
+use std::fmt::Write;
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use skin_core::model::{update_kinematics, JointKind, JointLimits, ModelData, RobotModel};
+
+use super::{pose_attrs, shape_attrs, MjcfError, ROBOT_GROUP};
+use crate::scene::Scene;
+
+/// The servo reaches its effort limit when the velocity error is this fraction of the joint's
+/// velocity limit (see [`servo_gain`]).
+pub const SERVO_ERROR_FRACTION: f64 = 0.1;
+
+/// Velocity servo gain `kv` \[N m s/rad or N s/m\] of a joint: `effort / (SERVO_ERROR_FRACTION *
+/// velocity)`, so that the servo uses its whole effort for a 10 % velocity error. For a UR5
+/// shoulder (150 N m, pi rad/s) that is 477 N m s/rad: with ~4 kg m² of arm inertia the time
+/// constant `I / kv` is about 8 ms, one 125 Hz control period. Gravity is compensated by MuJoCo
+/// (`gravcomp`), as a UR's own joint controllers do, so the servo does not sag under load.
+pub fn servo_gain(limits: &JointLimits) -> f64 {
+    limits.effort / (SERVO_ERROR_FRACTION * limits.velocity)
+}
+
+/// The robot's XML pieces: bodies (inside `<worldbody>`), contact exclusions, actuators.
+pub(super) struct RobotXml {
+    pub(super) bodies: String,
+    pub(super) contact: String,
+    pub(super) actuators: String,
+}
+
+/// MuJoCo body name of the body moved by joint `j`: the URDF name of the joint's child link.
+pub(crate) fn body_name(model: &RobotModel, j: usize) -> &str {
+    &model.frame_names()[model.joint_child_frame(j)]
+}
+
+pub(super) fn robot_xml(scene: &Scene) -> Result<RobotXml, MjcfError> {
+    let model = &scene.model;
+    let mut data = ModelData::new(model);
+    let zero = vec![0.0; model.nv()];
+    update_kinematics(model, &mut data, &zero, &zero).expect("q and qd have nv entries");
+    // Each body's pose in its parent body at q = 0 (the URDF joint origins, fixed joints folded in).
+    let placement: Vec<Isometry3<f64>> = (0..model.nv())
+        .map(|j| match model.joint_parent(j) {
+            Some(p) => data.joint_pose(p).inverse() * data.joint_pose(j),
+            None => *data.joint_pose(j),
+        })
+        .collect();
+
+    let mut bodies = String::new();
+    // Links fixed to the world with geometry (e.g. planar7's base) are static bodies of their own:
+    // MuJoCo never filters contacts with the world body itself, and such a link touches its child.
+    let static_links: Vec<usize> = (0..model.nframes())
+        .filter(|&f| model.frame_parent_joint(f).is_none() && !model.link_collisions(f).is_empty())
+        .collect();
+    for &f in &static_links {
+        let _ = writeln!(bodies, "    <body name=\"{}\">", model.frame_names()[f]);
+        frame_geoms(model, f, "      ", &mut bodies)?;
+        bodies.push_str("    </body>\n");
+    }
+    for root in (0..model.nv()).filter(|&j| model.joint_parent(j).is_none()) {
+        body_xml(scene, &placement, root, 2, &mut bodies)?;
+    }
+
+    // Contacts of a body with its parent and grandparent are not meaningful: they overlap at the
+    // joints (UR wrists). MuJoCo's own parent filter misses a parent welded to the world (a frozen
+    // base), so both are excluded explicitly, as are the static links and the root bodies.
+    let mut contact = String::from("  <contact>\n");
+    let mut exclude = |a: &str, b: &str| {
+        let _ = writeln!(contact, "    <exclude body1=\"{a}\" body2=\"{b}\"/>");
+    };
+    for j in 0..model.nv() {
+        let parent = model.joint_parent(j);
+        for a in [parent, parent.and_then(|p| model.joint_parent(p))].into_iter().flatten() {
+            exclude(body_name(model, a), body_name(model, j));
+        }
+        if parent.is_none() {
+            for &f in &static_links {
+                exclude(&model.frame_names()[f], body_name(model, j));
+            }
+        }
+    }
+    contact.push_str("  </contact>\n");
+
+    let mut actuators = String::from("  <actuator>\n");
+    for j in (0..model.nv()).filter(|&j| scene.moving[j]) {
+        let lim = model.joint_limits()[j];
+        let name = &model.joint_names()[j];
+        let _ = writeln!(
+            actuators,
+            "    <velocity name=\"{name}\" joint=\"{name}\" kv=\"{}\" forcerange=\"{} {}\" ctrlrange=\"{} {}\"/>",
+            servo_gain(&lim),
+            -lim.effort,
+            lim.effort,
+            -lim.velocity,
+            lim.velocity
+        );
+    }
+    actuators.push_str("  </actuator>\n");
+    Ok(RobotXml {
+        bodies,
+        contact,
+        actuators,
+    })
+}
+
+/// The body of joint `j` and, recursively, its children.
+fn body_xml(
+    scene: &Scene,
+    placement: &[Isometry3<f64>],
+    j: usize,
+    depth: usize,
+    xml: &mut String,
+) -> Result<(), MjcfError> {
+    let model = &scene.model;
+    let pad = "  ".repeat(depth);
+    let moving = scene.moving[j];
+    // A frozen joint is welded at its fixed position: its motion is folded into the placement.
+    let pose = if moving {
+        placement[j]
+    } else {
+        placement[j] * joint_motion(model, j, scene.q0[j])
+    };
+    let _ = writeln!(
+        xml,
+        "{pad}<body name=\"{}\" {} gravcomp=\"1\">",
+        body_name(model, j),
+        pose_attrs(&pose)
+    );
+    let (c, i) = (model.body_com(j), model.body_inertia(j));
+    let _ = writeln!(
+        xml,
+        "{pad}  <inertial pos=\"{} {} {}\" mass=\"{}\" fullinertia=\"{} {} {} {} {} {}\"/>",
+        c.x,
+        c.y,
+        c.z,
+        model.body_mass(j),
+        i[(0, 0)],
+        i[(1, 1)],
+        i[(2, 2)],
+        i[(0, 1)],
+        i[(0, 2)],
+        i[(1, 2)]
+    );
+    if moving {
+        let a = model.joint_axis(j);
+        let lim = model.joint_limits()[j];
+        let kind = match model.joint_kind(j) {
+            JointKind::Revolute => "hinge",
+            JointKind::Prismatic => "slide",
+        };
+        let range = if lim.lower.is_finite() && lim.upper.is_finite() {
+            format!(" range=\"{} {}\"", lim.lower, lim.upper)
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            xml,
+            "{pad}  <joint name=\"{}\" type=\"{kind}\" axis=\"{} {} {}\"{range}/>",
+            model.joint_names()[j],
+            a.x,
+            a.y,
+            a.z
+        );
+    }
+    for f in (0..model.nframes()).filter(|&f| model.frame_parent_joint(f) == Some(j)) {
+        frame_geoms(model, f, &format!("{pad}  "), xml)?;
+    }
+    for child in (0..model.nv()).filter(|&k| model.joint_parent(k) == Some(j)) {
+        body_xml(scene, placement, child, depth + 1, xml)?;
+    }
+    let _ = writeln!(xml, "{pad}</body>");
+    Ok(())
+}
+
+/// Transform of joint `j` at position `q`.
+fn joint_motion(model: &RobotModel, j: usize, q: f64) -> Isometry3<f64> {
+    let a = model.joint_axis(j);
+    match model.joint_kind(j) {
+        JointKind::Revolute => Isometry3::from_parts(Translation3::identity(), UnitQuaternion::from_scaled_axis(a * q)),
+        JointKind::Prismatic => Isometry3::from_parts(Translation3::from(a * q), UnitQuaternion::identity()),
+    }
+}
+
+/// The collision primitives of frame `f`, placed in the frame's body.
+fn frame_geoms(model: &RobotModel, f: usize, pad: &str, xml: &mut String) -> Result<(), MjcfError> {
+    for c in model.link_collisions(f) {
+        let pose = model.frame_placement(f) * c.origin;
+        let shape = shape_attrs(&c.shape).ok_or_else(|| MjcfError::Mesh {
+            link: model.frame_names()[f].clone(),
+        })?;
+        let _ = writeln!(xml, "{pad}<geom {shape} {} group=\"{ROBOT_GROUP}\"/>", pose_attrs(&pose));
+    }
+    Ok(())
+}

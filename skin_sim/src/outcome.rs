@@ -1,0 +1,48 @@
+//! The outcome checks of a run (the "done when"): each a named pass/fail with the measured
+//! number and its limit.
+
+use crate::metrics::{Metrics, RECOVERY_LIMIT_S};
+use crate::scenario::ForceTargets;
+
+/// One check.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Check {
+    /// What is checked.
+    pub name: &'static str,
+    /// Measured value and limit, readable.
+    pub detail: String,
+    /// Whether it holds.
+    pub passed: bool,
+}
+
+fn at_most(name: &'static str, value: f64, limit: f64, unit: &str) -> Check {
+    Check {
+        name,
+        detail: format!("{value:.3} {unit} (limit {limit} {unit})"),
+        // NaN (nothing measured) fails: a check must see data.
+        passed: value <= limit,
+    }
+}
+
+/// The checks of a run: no faulted cycle; paper 000 scenes: goal reached, every contact at most
+/// `ε_c` outside the pushes, pushes relieved within [`RECOVERY_LIMIT_S`]; paper 003 scenes with
+/// `targets`: the RMS force errors of Table 3.
+pub fn checks(m: &Metrics, targets: Option<ForceTargets>) -> Vec<Check> {
+    let mut out = vec![Check {
+        name: "no safe-stop cycles",
+        detail: format!("{} faulted cycles", m.faulted_cycles),
+        passed: m.faulted_cycles == 0,
+    }];
+    if let Some(g) = &m.goal {
+        out.push(at_most("goal reached", g.goal_error_m, g.goal_tolerance_m, "m"));
+        out.push(at_most("contact force <= eps_c (outside pushes)", g.max_contact_force_n, g.eps_c_n, "N"));
+        if !g.hard_contact_recovery_s.is_nan() {
+            out.push(at_most("hard push relieved", g.hard_contact_recovery_s, RECOVERY_LIMIT_S, "s"));
+        }
+    }
+    if let (Some(f), Some(t)) = (&m.force, targets) {
+        out.push(at_most("RMS force error w/o interaction", f.rms_force_error_n, t.rms_without_n, "N"));
+        out.push(at_most("RMS force error w/ interaction", f.rms_force_error_interaction_n, t.rms_with_n, "N"));
+    }
+    out
+}

@@ -1,0 +1,145 @@
+//! The two papers' signal figures as ready-made layouts over plain slices.
+
+use super::{intervals_where, Figure, Panel, Tint};
+
+/// Signals of a paper 000 run, laid out like its Figs. 3, 7 and 8; one sample per control cycle,
+/// every slice as long as `t`.
+#[derive(Debug, Clone, Copy)]
+pub struct Paper000Signals<'a> {
+    /// Time \[s\].
+    pub t: &'a [f64],
+    /// Active arrangement of Table I per sample: 0 = (a) avoidance first, 1 = (b) intentional
+    /// contact, 2 = (c) hard contact (`Arrangement.MODE_*`).
+    pub arrangement: &'a [usize],
+    /// End-effector speed ||x_dot|| \[m/s\].
+    pub ee_speed: &'a [f64],
+    /// Speed threshold eps_v of a local minimum \[m/s\].
+    pub eps_v: f64,
+    /// Proximity (avoidance) force at the closest point ||F_d|| \[N\].
+    pub avoidance_force: &'a [f64],
+    /// Largest contact force ||F_c|| \[N\].
+    pub contact_force: &'a [f64],
+    /// Permitted contact force eps_c \[N\].
+    pub eps_c: f64,
+    /// Norm of the commanded torque ||tau|| \[N m\].
+    pub torque_norm: &'a [f64],
+    /// Scripted external pushes `(start, end)` \[s\], shaded (the hard-contact scenario).
+    pub pushes: &'a [(f64, f64)],
+}
+
+/// Paper 000's figure: (a) arrangement, (b) end-effector speed with eps_v, (c) proximity force,
+/// (d) contact force with eps_c, (e) torque norm; intentional-contact periods (arrangement (b))
+/// and pushes shaded.
+pub fn paper000_figure(title: &str, s: &Paper000Signals) -> Figure {
+    let t = s.t;
+    let contact: Vec<bool> = s.arrangement.iter().map(|&a| a == 1).collect();
+    let mut fig = Figure::new(title)
+        .panel(Panel::steps(
+            "(a) Priority arrangement (Table I)",
+            "arrangement",
+            &["(a)", "(b)", "(c)"],
+            t,
+            s.arrangement,
+        ))
+        .panel(
+            Panel::lines("(b) End-effector speed", "speed [m/s]")
+                .line("||x_dot||", t, s.ee_speed)
+                .threshold("eps_v", s.eps_v),
+        )
+        .panel(
+            Panel::lines("(c) Proximity force at the closest point", "force [N]").line(
+                "||F_d||",
+                t,
+                s.avoidance_force,
+            ),
+        )
+        .panel(
+            Panel::lines("(d) Largest contact force", "force [N]")
+                .line("||F_c||", t, s.contact_force)
+                .threshold("eps_c", s.eps_c),
+        )
+        .panel(Panel::lines("(e) Torque norm", "torque [N m]").line("||tau||", t, s.torque_norm));
+    for (a, b) in intervals_where(t, &contact) {
+        fig = fig.shade(a, b, "intentional contact", Tint::Green);
+    }
+    for &(a, b) in s.pushes {
+        fig = fig.shade(a, b, "external push", Tint::Red);
+    }
+    fig
+}
+
+/// Signals of a paper 003 force experiment, laid out like its Figs. 5, 7 and 8; one sample per
+/// control cycle, every slice as long as `t`.
+#[derive(Debug, Clone, Copy)]
+pub struct Paper003Signals<'a> {
+    /// Time \[s\].
+    pub t: &'a [f64],
+    /// Desired normal hand force \[N\].
+    pub force_desired: &'a [f64],
+    /// Measured normal hand force \[N\].
+    pub force_measured: &'a [f64],
+    /// State machine phase per sample (Table 1): 0 = pre-contact, 1 = contact.
+    pub phase: &'a [usize],
+    /// Force/proximity fusion weight w of eq. 6, \[0, 1\].
+    pub fusion_weight: &'a [f64],
+    /// Mobile-base speed \[m/s\].
+    pub base_speed: &'a [f64],
+    /// Tactile guidance periods `(start, end)` \[s\] (green in the paper).
+    pub tactile: &'a [(f64, f64)],
+    /// Mobile-base collision avoidance periods `(start, end)` \[s\] (red in the paper).
+    pub base_avoidance: &'a [(f64, f64)],
+}
+
+/// Paper 003's figure: (a) desired and measured hand force, (b) force error with its RMS over
+/// the contact phase (the measure of Table 3), (c) phase, (d) fusion weight, (e) base speed;
+/// tactile and base-avoidance periods shaded.
+pub fn paper003_figure(title: &str, s: &Paper003Signals) -> Figure {
+    let t = s.t;
+    let error: Vec<f64> = s
+        .force_measured
+        .iter()
+        .zip(s.force_desired)
+        .map(|(m, d)| m - d)
+        .collect();
+    let in_contact = error
+        .iter()
+        .zip(s.phase)
+        .filter(|(_, &p)| p == 1)
+        .map(|(e, _)| e * e);
+    let (sum, n) = in_contact.fold((0.0, 0usize), |(sum, n), e2| (sum + e2, n + 1));
+    let error_title = match n {
+        0 => "(b) Force error".to_string(),
+        _ => format!(
+            "(b) Force error (RMS in contact {:.3} N)",
+            (sum / n as f64).sqrt()
+        ),
+    };
+    let mut fig = Figure::new(title)
+        .panel(
+            Panel::lines("(a) Hand force", "force [N]")
+                .line("measured", t, s.force_measured)
+                // Drawn last: the reference stays visible over the measurement.
+                .line("desired", t, s.force_desired),
+        )
+        .panel(Panel::lines(&error_title, "error [N]").line("measured - desired", t, &error))
+        .panel(Panel::steps(
+            "(c) Phase (Table 1)",
+            "phase",
+            &["pre-contact", "contact"],
+            t,
+            s.phase,
+        ))
+        .panel(Panel::lines("(d) Fusion weight (eq. 6)", "w [-]").line("w", t, s.fusion_weight))
+        .panel(Panel::lines("(e) Mobile-base speed", "speed [m/s]").line(
+            "||v_b||",
+            t,
+            s.base_speed,
+        ));
+    for &(a, b) in s.tactile {
+        fig = fig.shade(a, b, "tactile guidance", Tint::Green);
+    }
+    for &(a, b) in s.base_avoidance {
+        fig = fig.shade(a, b, "base collision avoidance", Tint::Red);
+    }
+    fig
+}

@@ -1,0 +1,74 @@
+//! Physical contact forces read from MuJoCo's contacts (ground truth, not the skin): the force
+//! pressing on the hand (paper 003's `f_c` in newtons) and the largest force on one robot link
+//! (paper 000's `‖F_c‖` against `ε_c`).
+
+use mujoco_rs::mujoco_c;
+use nalgebra::Vector3;
+
+use crate::frames::FrameRef;
+use crate::mjcf::ROBOT_GROUP;
+use crate::world::World;
+
+/// Contact forces on the robot at the world's current state.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ContactForces {
+    /// Environment force pressing on the hand body along `-z_h` (into the palm) \[N\].
+    pub hand_n: f64,
+    /// Largest total normal force of the environment on one robot body \[N\].
+    pub max_link_n: f64,
+}
+
+/// Measures contact forces for one hand frame (a URDF link of the scene's robot).
+#[derive(Debug, Clone)]
+pub struct ContactProbe {
+    hand: FrameRef,
+    hand_frame: usize,
+    /// Scratch: total normal force per MuJoCo body.
+    per_body: Vec<f64>,
+}
+
+impl ContactProbe {
+    /// A probe for the hand frame `hand_frame` (model frame index) of `world`.
+    pub fn new(world: &World, hand_frame: usize) -> Self {
+        ContactProbe {
+            hand: FrameRef::new(&world.scene().model, world.mj_model(), hand_frame),
+            hand_frame,
+            per_body: vec![0.0; world.mj_model().ffi().nbody as usize],
+        }
+    }
+
+    /// The forces of the world's current contacts: every contact between a robot geom and the
+    /// environment (objects, persons, floor) contributes its normal force (`mj_contactForce`).
+    pub fn measure(&mut self, world: &World) -> ContactForces {
+        let (model, data) = (world.mj_model(), world.mj_data());
+        let (group, geom_body) = (model.geom_group(), model.geom_bodyid());
+        let z_hand = world.frame_pose(self.hand_frame).rotation * Vector3::z();
+        self.per_body.fill(0.0);
+        let mut hand_n = 0.0;
+        for (k, con) in data.contact().iter().enumerate() {
+            let [g1, g2] = [con.geom1 as usize, con.geom2 as usize];
+            let robot = |g: usize| group[g] == ROBOT_GROUP as i32;
+            if robot(g1) == robot(g2) {
+                continue; // self-contact or environment only
+            }
+            let mut f = [0.0; 6];
+            // SAFETY: model and data belong together and k < ncon.
+            unsafe { mujoco_c::mj_contactForce(model.ffi(), data.ffi(), k as i32, &mut f) };
+            if f[0] <= 0.0 {
+                continue;
+            }
+            // The normal points from geom1 to geom2; the force pushes geom2 along it.
+            let normal = Vector3::new(con.frame[0], con.frame[1], con.frame[2]) * f[0];
+            let (body, on_robot) = if robot(g1) { (geom_body[g1], -normal) } else { (geom_body[g2], normal) };
+            let body = body as usize;
+            self.per_body[body] += f[0];
+            if body == self.hand.body {
+                hand_n += (-on_robot.dot(&z_hand)).max(0.0);
+            }
+        }
+        ContactForces {
+            hand_n,
+            max_link_n: self.per_body.iter().copied().fold(0.0, f64::max),
+        }
+    }
+}

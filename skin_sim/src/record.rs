@@ -1,0 +1,111 @@
+//! The run record of a closed-loop simulation: one [`CycleRecord`] per control cycle and the
+//! arrangement switches, everything the metrics, the summary, the plots (`skin_sim::plot`) and the
+//! bag writer (`skin_sim::bag`) read. Plain data; nothing in it is computed twice.
+
+use skin_core::supervisor::{Mode, SupervisorInput};
+
+/// One control cycle: the measurements the controller got, what it decided and what the
+/// simulation measured at the same instant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CycleRecord {
+    /// Simulation time of the measurements \[s\].
+    pub t_s: f64,
+    /// Joint positions, model order (frozen joints: their fixed value).
+    pub q: Vec<f64>,
+    /// Joint velocities, model order (frozen joints: 0).
+    pub qd: Vec<f64>,
+    /// Commanded arm joint velocities, in [`RunRecord::arm_joints`] order \[rad/s or m/s\].
+    pub joint_velocities: Vec<f64>,
+    /// Commanded base twist `(vx, vy, wz)` in the base frame (the controller's plus any scripted
+    /// base motion of the scene).
+    pub base_twist: [f64; 3],
+    /// Active arrangement (paper 000 Table I / paper 003 Table 1).
+    pub mode: Mode,
+    /// `χ` of paper 000 eq. (10)-(11), 0 outside a blend.
+    pub blend: f64,
+    /// The supervisor's signals: ee speed, `‖F_d‖`, skin contact force `‖F_c‖`, goal error.
+    pub signals: SupervisorInput,
+    /// `‖τ*‖` \[N m\].
+    pub torque_norm: f64,
+    /// Normal force of the environment pressing on the hand along its z axis, from MuJoCo's
+    /// contacts \[N\] (paper 003's contact force `f_c`, measured physically).
+    pub hand_force_n: f64,
+    /// Largest total normal contact force of the environment on one robot link, from MuJoCo
+    /// \[N\] (the physical counterpart of the skin's `‖F_c‖`).
+    pub link_force_n: f64,
+    /// Force reference of the scene at this time \[N\] (NaN: none active).
+    pub force_reference_n: f64,
+    /// The hand signal reference `f_c,d` given to the controller (NaN: none).
+    pub force_reference_signal: f64,
+    /// Whether a scripted interaction (push on the robot, a person near the base, scripted base
+    /// motion) is going on.
+    pub interaction: bool,
+    /// The controller's fault text when the cycle was a safe-stop step.
+    pub fault: Option<String>,
+    /// Wall-clock time of `Controller::update` \[µs\] (the only field that is not reproducible).
+    pub compute_us: f64,
+}
+
+/// One arrangement switch of the supervisor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Switch {
+    /// Time of the switch \[s\].
+    pub t_s: f64,
+    /// Mode before.
+    pub from: Mode,
+    /// Mode after.
+    pub to: Mode,
+}
+
+/// A whole run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunRecord {
+    /// Scenario name (or the scene file's stem).
+    pub name: String,
+    /// The scene file.
+    pub scene_file: String,
+    /// Joint names, model order (the order of `q`, `qd`).
+    pub joint_names: Vec<String>,
+    /// Names of the commanded arm joints (the order of `joint_velocities`).
+    pub arm_joints: Vec<String>,
+    /// Control rate \[Hz\].
+    pub control_rate_hz: f64,
+    /// MuJoCo timestep \[s\].
+    pub timestep_s: f64,
+    /// Seed of the sensor noise.
+    pub seed: u64,
+    /// One entry per control cycle, in time order.
+    pub cycles: Vec<CycleRecord>,
+    /// Arrangement switches in time order.
+    pub switches: Vec<Switch>,
+    /// Wall-clock duration of the run \[s\].
+    pub wall_time_s: f64,
+}
+
+impl RunRecord {
+    /// Simulated duration \[s\]: control cycles times the control period.
+    pub fn sim_duration_s(&self) -> f64 {
+        self.cycles.len() as f64 / self.control_rate_hz
+    }
+
+    /// A copy without the wall-clock fields, for comparing runs bit for bit.
+    pub fn without_timing(&self) -> RunRecord {
+        let mut r = self.clone();
+        r.wall_time_s = 0.0;
+        for c in &mut r.cycles {
+            c.compute_us = 0.0;
+        }
+        r
+    }
+}
+
+/// The name of a mode as in `config/supervisor.yaml`'s arrangements.
+pub fn mode_name(mode: Mode) -> &'static str {
+    match mode {
+        Mode::Avoidance => "avoidance",
+        Mode::IntentionalContact => "intentional_contact",
+        Mode::HardContact => "hard_contact",
+        Mode::PreContact => "precontact",
+        Mode::Contact => "contact",
+    }
+}

@@ -1,0 +1,94 @@
+//! The scenarios: a scene file, the controller setup that runs it, and the outcome the papers
+//! report for it (checked by [`crate::outcome`]). `docs/scenarios.md` has the measured numbers.
+
+use std::path::{Path, PathBuf};
+
+/// Paper 003 Table 3 targets: RMS force-tracking errors \[N\].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ForceTargets {
+    /// Without interactions (contact phase, after it settled).
+    pub rms_without_n: f64,
+    /// During interactions.
+    pub rms_with_n: f64,
+}
+
+/// A named scenario.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scenario {
+    /// Name (`skin_sim run <name>`), also the scene file's stem.
+    pub name: &'static str,
+    /// What it reproduces, one line.
+    pub description: &'static str,
+    /// Controller setup file in `config/controller/`.
+    pub controller: &'static str,
+    /// Paper 003 Table 3 targets (None: a paper 000 scenario, judged on goal and contact force).
+    pub force_targets: Option<ForceTargets>,
+}
+
+/// Every scenario, paper 000 first.
+pub const SCENARIOS: [Scenario; 7] = [
+    Scenario {
+        name: "intentional_contact",
+        description: "paper 000 Figs. 2-3: planar 7-DoF arm pushes a movable obstacle out of a local minimum; hard push at 15 s",
+        controller: "planar7.yaml",
+        force_targets: None,
+    },
+    Scenario {
+        name: "tomm_movable_obstacles",
+        description: "paper 000 Fig. 5: TOMM's right arm reaches a goal over a table through movable obstacles",
+        controller: "tomm.yaml",
+        force_targets: None,
+    },
+    Scenario {
+        name: "tomm_fixed_obstacle",
+        description: "paper 000 Fig. 6: a fixed and a movable block form a local minimum; the arm pushes the movable one",
+        controller: "tomm.yaml",
+        force_targets: None,
+    },
+    Scenario {
+        name: "force_tracking_base_motion",
+        description: "paper 003 Exp. 1 (Fig. 5): the hand tracks a 4 +- 1 N sinusoid on a board",
+        controller: "tomm_phases.yaml",
+        force_targets: Some(ForceTargets { rms_without_n: 0.16, rms_with_n: 0.37 }),
+    },
+    Scenario {
+        name: "tactile_guidance",
+        description: "paper 003 Exp. 2 (Fig. 6): proximity approach to a table, touches guide the hand, a person nears the base",
+        controller: "tomm_phases_table.yaml",
+        force_targets: None,
+    },
+    Scenario {
+        name: "force_tracking_interaction",
+        description: "paper 003 Exp. 3 (Fig. 7): 5 +- 2 N sinusoid while the arm is touched and a person nears the base",
+        controller: "tomm_phases.yaml",
+        force_targets: Some(ForceTargets { rms_without_n: 0.23, rms_with_n: 0.58 }),
+    },
+    Scenario {
+        name: "poster_phrc",
+        description: "paper 003 Exp. 4 (Figs. 1, 8): hold a poster on a tilted wall with 6 N while the user works next to the robot",
+        controller: "tomm_phases.yaml",
+        force_targets: Some(ForceTargets { rms_without_n: 0.42, rms_with_n: 0.80 }),
+    },
+];
+
+/// The scenario called `name`.
+pub fn find(name: &str) -> Option<&'static Scenario> {
+    SCENARIOS.iter().find(|s| s.name == name)
+}
+
+/// The repository's `config/` directory (scenes and controller setups).
+pub fn config_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../config")
+}
+
+impl Scenario {
+    /// Its scene file.
+    pub fn scene_file(&self) -> PathBuf {
+        config_dir().join("scenes").join(format!("{}.yaml", self.name))
+    }
+
+    /// Its controller setup file.
+    pub fn controller_file(&self) -> PathBuf {
+        config_dir().join("controller").join(self.controller)
+    }
+}

@@ -1,0 +1,337 @@
+//! The scene file schema (`config/scenes/*.yaml`), as written: every key, its unit and its
+//! default. `docs/scenes.md` documents the same keys for readers of the files.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+/// One scene file. Relative paths are relative to the scene file's directory.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSpec {
+    /// The robot and the part of it that moves.
+    pub robot: RobotSpec,
+    /// Simulated skin (none: no skin readings).
+    #[serde(default)]
+    pub skin: Option<SkinSpec>,
+    /// Simulated base LIDAR (none: no scan).
+    #[serde(default)]
+    pub lidar: Option<LidarSpec>,
+    /// Boxes, cylinders, tables, walls around the robot.
+    #[serde(default)]
+    pub objects: Vec<ObjectSpec>,
+    /// Scripted external forces on objects or robot links.
+    #[serde(default)]
+    pub pushes: Vec<PushSpec>,
+    /// Person-sized bodies moving along scripted paths.
+    #[serde(default)]
+    pub persons: Vec<PersonSpec>,
+    /// End-effector goals for the controller (data only: the simulation does not use them).
+    #[serde(default)]
+    pub goals: Vec<GoalSpec>,
+    /// Contact force references for the controller (data only).
+    #[serde(default)]
+    pub force_references: Vec<ForceReferenceSpec>,
+    /// Length of a run \[s\].
+    pub duration_s: f64,
+    /// MuJoCo integration step \[s\]; every other period is a multiple of it.
+    #[serde(default = "default_timestep")]
+    pub timestep_s: f64,
+    /// Rate of the arm velocity commands \[Hz\] (TOMM's UR5: 125 Hz, paper 003 Sec. 4.1).
+    #[serde(default = "default_control_rate")]
+    pub control_rate_hz: f64,
+    /// Height of the floor plane \[m\].
+    #[serde(default)]
+    pub floor_z_m: f64,
+    /// Seed of every random number of the run (sensor noise).
+    #[serde(default)]
+    pub seed: u64,
+}
+
+fn default_timestep() -> f64 {
+    0.001
+}
+fn default_control_rate() -> f64 {
+    125.0
+}
+
+/// The robot: its URDF, the joints that move, and where every joint starts.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RobotSpec {
+    /// URDF file.
+    pub urdf: PathBuf,
+    /// Moving joints kept in the simulation (none: all). Every other joint is frozen: welded at
+    /// its `initial` position.
+    #[serde(default)]
+    pub joints: Option<Vec<String>>,
+    /// Joint positions \[rad or m\] by joint name: where kept joints start and where frozen
+    /// joints stay. Unlisted joints: 0.
+    #[serde(default)]
+    pub initial: BTreeMap<String, f64>,
+}
+
+/// The simulated skin.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SkinSpec {
+    /// Skin layout file (`config/skin/<robot>.yaml`).
+    pub layout: PathBuf,
+    /// Skin model parameters (`config/skin_model.yaml`): the cells' characteristics.
+    pub params: PathBuf,
+    /// Ids of the patches that sense (none: all); cells of other patches read 0.
+    #[serde(default)]
+    pub patches: Option<Vec<u32>>,
+    /// Sample rate \[Hz\] (paper 003 Sec. 4.1: 250 Hz).
+    #[serde(default = "default_skin_rate")]
+    pub rate_hz: f64,
+    /// Contacts are given to the cells of the touched link within this distance \[m\] (about one
+    /// cell pitch).
+    #[serde(default = "default_contact_radius")]
+    pub contact_radius_m: f64,
+    /// Standard deviation of the Gaussian noise added to each proximity signal (normalized).
+    #[serde(default)]
+    pub proximity_noise_std: f64,
+    /// Standard deviation of the Gaussian noise added to each force signal (normalized).
+    #[serde(default)]
+    pub force_noise_std: f64,
+}
+
+fn default_skin_rate() -> f64 {
+    250.0
+}
+fn default_contact_radius() -> f64 {
+    0.035
+}
+
+/// A planar LIDAR fan in the plane of a robot frame (its x-y plane), reported in the base frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LidarSpec {
+    /// The URDF link the scanner is at.
+    #[serde(default = "default_lidar_frame")]
+    pub frame: String,
+    /// Number of rays, evenly spread over `fov_deg`.
+    #[serde(default = "default_rays")]
+    pub rays: usize,
+    /// Field of view \[deg\], centred on the frame's x axis.
+    #[serde(default = "default_fov")]
+    pub fov_deg: f64,
+    /// Maximum range \[m\]; farther hits are not reported.
+    #[serde(default = "default_range")]
+    pub range_m: f64,
+    /// Scan rate \[Hz\].
+    #[serde(default = "default_lidar_rate")]
+    pub rate_hz: f64,
+    /// Standard deviation of the Gaussian noise added to each range \[m\].
+    #[serde(default)]
+    pub noise_std_m: f64,
+}
+
+fn default_lidar_frame() -> String {
+    "laser".into()
+}
+fn default_rays() -> usize {
+    360
+}
+fn default_fov() -> f64 {
+    360.0
+}
+fn default_range() -> f64 {
+    10.0
+}
+fn default_lidar_rate() -> f64 {
+    40.0
+}
+
+/// A rigid object: fixed to the world, or free (movable) when it has a mass.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectSpec {
+    /// Unique name (also the MuJoCo body name).
+    pub name: String,
+    /// Geometry.
+    pub shape: ShapeSpec,
+    /// Position of the object frame in the world \[m\] (a table: the floor point under its top's
+    /// centre).
+    pub xyz: [f64; 3],
+    /// Orientation, roll-pitch-yaw \[rad\] (URDF convention); a tilted wall is a rotated box.
+    #[serde(default)]
+    pub rpy: [f64; 3],
+    /// Mass \[kg\]: the object is free (movable). None: fixed to the world.
+    #[serde(default)]
+    pub mass_kg: Option<f64>,
+    /// Sliding friction coefficient against anything it touches.
+    #[serde(default = "default_friction")]
+    pub friction: f64,
+}
+
+fn default_friction() -> f64 {
+    1.0
+}
+
+/// Object geometry; lengths in m, centred on the object frame (cylinders and capsules along z).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum ShapeSpec {
+    /// Box with full edge lengths.
+    Box {
+        /// Edge lengths along x, y, z \[m\].
+        size_m: [f64; 3],
+    },
+    /// Cylinder along z.
+    Cylinder {
+        /// Radius \[m\].
+        radius_m: f64,
+        /// Length \[m\].
+        length_m: f64,
+    },
+    /// Sphere.
+    Sphere {
+        /// Radius \[m\].
+        radius_m: f64,
+    },
+    /// Capsule along z.
+    Capsule {
+        /// Radius \[m\].
+        radius_m: f64,
+        /// Length of the cylindrical part \[m\].
+        length_m: f64,
+    },
+    /// A table: a box top on four cylindrical legs at its corners, standing on the object frame.
+    Table {
+        /// Top edge lengths along x, y and its thickness \[m\].
+        top_m: [f64; 3],
+        /// Height of the top's upper surface above the object frame \[m\].
+        height_m: f64,
+        /// Leg radius \[m\].
+        #[serde(default = "default_leg_radius")]
+        leg_radius_m: f64,
+    },
+}
+
+fn default_leg_radius() -> f64 {
+    0.025
+}
+
+/// A constant force on an object or a robot link during a time window.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PushSpec {
+    /// Target object name (exactly one of `object`, `link`).
+    #[serde(default)]
+    pub object: Option<String>,
+    /// Target robot link (URDF link name).
+    #[serde(default)]
+    pub link: Option<String>,
+    /// Force in the world frame \[N\].
+    pub force_n: [f64; 3],
+    /// Point of application in the target's frame \[m\].
+    #[serde(default)]
+    pub point_m: [f64; 3],
+    /// Start of the window \[s\].
+    pub start_s: f64,
+    /// End of the window \[s\].
+    pub end_s: f64,
+}
+
+/// A person-sized vertical capsule standing on the floor, moved along a path (a mocap body: it
+/// pushes whatever it meets and is seen by the skin and the LIDAR).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PersonSpec {
+    /// Unique name (also the MuJoCo body name).
+    pub name: String,
+    /// Radius \[m\].
+    #[serde(default = "default_person_radius")]
+    pub radius_m: f64,
+    /// Height \[m\].
+    #[serde(default = "default_person_height")]
+    pub height_m: f64,
+    /// Waypoints, times strictly increasing; the position is interpolated linearly between them
+    /// and held before the first and after the last.
+    pub path: Vec<WaypointSpec>,
+}
+
+fn default_person_radius() -> f64 {
+    0.2
+}
+fn default_person_height() -> f64 {
+    1.7
+}
+
+/// One waypoint of a person's path.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WaypointSpec {
+    /// Time \[s\].
+    pub t_s: f64,
+    /// Floor position, world x and y \[m\].
+    pub xy_m: [f64; 2],
+}
+
+/// A goal of an end-effector frame from a start time on (paper 000 eq. (7)-(9)).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GoalSpec {
+    /// The URDF link (frame) that should reach the goal.
+    pub frame: String,
+    /// When the goal becomes active \[s\].
+    #[serde(default)]
+    pub start_s: f64,
+    /// Goal position in the world \[m\].
+    pub position_m: [f64; 3],
+    /// Goal orientation, roll-pitch-yaw in the world \[rad\] (none: position only).
+    #[serde(default)]
+    pub rpy: Option<[f64; 3]>,
+}
+
+/// A contact force reference from a start time on: `mean + amplitude sin(2 pi (t - start) / period)`
+/// (paper 003 Exp. 1, 3: sinusoids; Exp. 4: constant).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForceReferenceSpec {
+    /// When the reference becomes active \[s\].
+    #[serde(default)]
+    pub start_s: f64,
+    /// Mean force \[N\].
+    pub mean_n: f64,
+    /// Amplitude \[N\] (0: constant).
+    #[serde(default)]
+    pub amplitude_n: f64,
+    /// Period \[s\] (required when the amplitude is not 0).
+    #[serde(default)]
+    pub period_s: Option<f64>,
+}
+
+impl ForceReferenceSpec {
+    /// The reference at time `t_s` (the mean before `start_s`, where no sinusoid has begun).
+    pub fn value(&self, t_s: f64) -> f64 {
+        match self.period_s {
+            Some(p) if t_s > self.start_s => {
+                self.mean_n + self.amplitude_n * (std::f64::consts::TAU * (t_s - self.start_s) / p).sin()
+            }
+            _ => self.mean_n,
+        }
+    }
+}
+
+impl PersonSpec {
+    /// Floor position at time `t_s`: piecewise-linear along the path, held at its ends.
+    pub fn position(&self, t_s: f64) -> [f64; 2] {
+        let path = &self.path;
+        let (first, last) = (path[0], path[path.len() - 1]);
+        if t_s <= first.t_s {
+            return first.xy_m;
+        }
+        if t_s >= last.t_s {
+            return last.xy_m;
+        }
+        // Validation guarantees increasing times, so exactly one segment contains t_s.
+        let k = path.partition_point(|w| w.t_s <= t_s);
+        let (a, b) = (path[k - 1], path[k]);
+        let s = (t_s - a.t_s) / (b.t_s - a.t_s);
+        [a.xy_m[0] + s * (b.xy_m[0] - a.xy_m[0]), a.xy_m[1] + s * (b.xy_m[1] - a.xy_m[1])]
+    }
+}

@@ -1,0 +1,193 @@
+//! Simulated skin: per cell, the proximity sensor as a ray along the cell's outward normal and
+//! the three force sensors from the MuJoCo contacts near the cell, both through the cell
+//! characteristics of `config/skin_model.yaml` (paper 003 Sec. 2.3: normalized, nonlinear).
+//!
+//! - Proximity: `mj_ray` from the cell's world position along its outward normal, testing only
+//!   objects and persons ([`SENSED_GROUPS`]: the robot never sees itself); the hit distance goes
+//!   through `p(d)` (0 from the sensor range on). A cell in contact reads 1.
+//! - Force: each contact that involves a robot geom gives its normal force (`mj_contactForce`) to
+//!   the cells of the touched body within `contact_radius_m` of the contact point, split with
+//!   weights falling linearly with distance and proportional to how squarely the cell faces the
+//!   force; a cell keeps the part of its share pressing along its inward normal, and that force
+//!   in newtons goes through `f(F)` on all three sensors.
+//! - Optional zero-mean Gaussian noise on every signal (seeded), then clamped to [0, 1].
+
+use std::ops::Range;
+
+use mujoco_rs::mujoco_c;
+use mujoco_rs::prelude::*;
+use mujoco_rs::wrappers::mj_model::traits::ModelType;
+use nalgebra::{Point3, Vector3};
+use skin_core::skin::characteristic::{PreparedForce, PreparedProximity};
+use skin_core::skin::signals::CellReading;
+
+use crate::frames::{body_pose, FrameRef};
+use crate::mjcf::{ROBOT_GROUP, SENSED_GROUPS};
+use crate::noise::Noise;
+use crate::scene::Scene;
+
+/// One cell in its MuJoCo body's frame.
+#[derive(Debug, Clone, Copy)]
+struct SimCell {
+    body: usize,
+    position: Point3<f64>,
+    normal: Vector3<f64>,
+    active: bool,
+}
+
+/// The skin of a [`crate::world::World`]; readings are indexed like the scene layout's cells.
+#[derive(Debug, Clone)]
+pub struct SkinSensor {
+    cells: Vec<SimCell>,
+    /// Cell indices ordered by body, and each MuJoCo body's range in that order.
+    by_body: Vec<usize>,
+    body_range: Vec<Range<usize>>,
+    proximity: PreparedProximity,
+    force: PreparedForce,
+    contact_radius_m: f64,
+    proximity_noise_std: f64,
+    force_noise_std: f64,
+    noise: Noise,
+    /// Scratch: normal force per cell \[N\].
+    force_n: Vec<f64>,
+    readings: Vec<CellReading>,
+}
+
+/// Noise stream of the skin (see [`Noise::new`]).
+const NOISE_STREAM: u64 = 1;
+
+impl SkinSensor {
+    /// The skin of `scene` (None when it has none) on the MuJoCo model generated from it.
+    pub(crate) fn new(scene: &Scene, mj: &MjModel) -> Option<Self> {
+        let (skin, spec) = (scene.skin.as_ref()?, scene.spec.skin.as_ref()?);
+        let cells: Vec<SimCell> = skin
+            .layout
+            .cells()
+            .iter()
+            .zip(&skin.active)
+            .map(|(c, &active)| {
+                let f = FrameRef::new(&scene.model, mj, c.frame);
+                SimCell {
+                    body: f.body,
+                    position: f.placement * Point3::from(c.position_link),
+                    normal: f.placement * c.normal_link,
+                    active,
+                }
+            })
+            .collect();
+        let mut by_body: Vec<usize> = (0..cells.len()).collect();
+        by_body.sort_by_key(|&i| cells[i].body);
+        let nbody = mj.ffi().nbody as usize;
+        let body_range = (0..nbody)
+            .map(|b| {
+                let start = by_body.partition_point(|&i| cells[i].body < b);
+                let end = by_body.partition_point(|&i| cells[i].body <= b);
+                start..end
+            })
+            .collect();
+        let n = cells.len();
+        Some(SkinSensor {
+            cells,
+            by_body,
+            body_range,
+            proximity: skin.params.proximity.prepared(),
+            force: skin.params.force.prepared(),
+            contact_radius_m: spec.contact_radius_m,
+            proximity_noise_std: spec.proximity_noise_std,
+            force_noise_std: spec.force_noise_std,
+            noise: Noise::new(scene.spec.seed, NOISE_STREAM),
+            force_n: vec![0.0; n],
+            readings: vec![CellReading::default(); n],
+        })
+    }
+
+    /// The last sample, indexed like the layout's cells (inactive cells read 0).
+    pub fn readings(&self) -> &[CellReading] {
+        &self.readings
+    }
+
+    /// World position and outward unit normal of cell `i` at the data's current kinematics.
+    pub fn cell_world<M: ModelType>(&self, data: &MjData<M>, i: usize) -> (Point3<f64>, Vector3<f64>) {
+        let c = &self.cells[i];
+        let pose = body_pose(data, c.body);
+        (pose * c.position, pose * c.normal)
+    }
+
+    /// Samples every active cell from the data's current kinematics and contacts.
+    pub(crate) fn sample<M: ModelType>(&mut self, data: &mut MjData<M>) {
+        self.contact_forces(data);
+        for i in 0..self.cells.len() {
+            if !self.cells[i].active {
+                continue;
+            }
+            let f = self.force_n[i];
+            let p = if f > 0.0 { 1.0 } else { self.ray_proximity(data, i) };
+            let force = self.force.signal(f);
+            let mut reading = CellReading {
+                force: [force; 3],
+                proximity: p,
+            };
+            for s in &mut reading.force {
+                *s = (*s + self.noise.gaussian(self.force_noise_std)).clamp(0.0, 1.0);
+            }
+            reading.proximity = (reading.proximity + self.noise.gaussian(self.proximity_noise_std)).clamp(0.0, 1.0);
+            self.readings[i] = reading;
+        }
+    }
+
+    fn ray_proximity<M: ModelType>(&self, data: &mut MjData<M>, i: usize) -> f64 {
+        let (p, n) = self.cell_world(data, i);
+        // flg_static = true: fixed objects and mocap persons are static bodies and must be seen.
+        let (hit, d) = data.ray(&[p.x, p.y, p.z], &[n.x, n.y, n.z], Some(&SENSED_GROUPS), true, None, None);
+        match hit {
+            Some(_) => self.proximity.signal(d),
+            None => 0.0,
+        }
+    }
+
+    /// Fills `force_n` with each cell's share of the normal contact forces on the robot.
+    fn contact_forces<M: ModelType>(&mut self, data: &MjData<M>) {
+        self.force_n.fill(0.0);
+        let model = data.model();
+        let (group, geom_body) = (model.geom_group(), model.geom_bodyid());
+        for (k, con) in data.contact().iter().enumerate() {
+            let [g1, g2] = [con.geom1 as usize, con.geom2 as usize];
+            let mut force = [0.0; 6];
+            // SAFETY: model and data belong together and k < ncon.
+            unsafe { mujoco_c::mj_contactForce(model.ffi(), data.ffi(), k as i32, &mut force) };
+            if force[0] <= 0.0 {
+                continue;
+            }
+            // The contact normal points from geom1 to geom2; the force pushes geom2 along it.
+            let normal = Vector3::new(con.frame[0], con.frame[1], con.frame[2]) * force[0];
+            let pos = Point3::from(con.pos);
+            for (g, f) in [(g1, -normal), (g2, normal)] {
+                if group[g] == ROBOT_GROUP as i32 {
+                    self.distribute(data, geom_body[g] as usize, &pos, &f);
+                }
+            }
+        }
+    }
+
+    /// Splits force `f` (world, acting on body `body` at `pos`) over the body's cells near `pos`.
+    fn distribute<M: ModelType>(&mut self, data: &MjData<M>, body: usize, pos: &Point3<f64>, f: &Vector3<f64>) {
+        let r = self.contact_radius_m;
+        let range = self.body_range[body].clone();
+        let pose = body_pose(data, body);
+        let local_pos = pose.inverse_transform_point(pos);
+        let local_f = pose.inverse_transform_vector(f);
+        let direction = local_f.normalize();
+        // A cell carries a share when it is near and faces the force (pressing = along its inward
+        // normal, -n): cells at right angles to it (a palm's rim under a flat contact) take none,
+        // so the pressing force is not lost to them.
+        let weight = |c: &SimCell| (1.0 - (c.position - local_pos).norm() / r).max(0.0) * (-direction.dot(&c.normal)).max(0.0);
+        let total: f64 = self.by_body[range.clone()].iter().map(|&i| weight(&self.cells[i])).sum();
+        if total <= 0.0 {
+            return; // no skin there facing the force
+        }
+        for &i in &self.by_body[range] {
+            let c = &self.cells[i];
+            self.force_n[i] += weight(c) / total * (-local_f.dot(&c.normal)).max(0.0);
+        }
+    }
+}

@@ -1,0 +1,371 @@
+//! The simulated world of a scene: MuJoCo model and data generated from it, the robot's velocity
+//! interface (arm joint velocities, a base twist in the base frame), its state in skin_core's
+//! joint order, scripted pushes and persons, and the skin and LIDAR sampled at their rates.
+
+use std::path::Path;
+use std::sync::Once;
+
+use mujoco_rs::prelude::*;
+use nalgebra::{Isometry3, Point3, Vector3};
+use skin_core::resolver::BASE_JOINTS;
+use skin_core::skin::signals::CellReading;
+use thiserror::Error;
+
+use crate::frames::{body_pose, FrameRef};
+use crate::lidar::Lidar;
+use crate::mjcf::{scene_xml, MjcfError};
+use crate::scene::{Scene, SceneError};
+use crate::skin_sensor::SkinSensor;
+
+/// Errors building or driving a [`World`].
+#[derive(Debug, Error)]
+pub enum WorldError {
+    /// The scene file is invalid.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The robot cannot be written as MJCF.
+    #[error("{file}: {source}")]
+    Mjcf {
+        /// The scene file.
+        file: String,
+        /// What is wrong.
+        source: MjcfError,
+    },
+    /// MuJoCo rejected the generated model.
+    #[error("{file}: MuJoCo cannot load the generated model: {message}")]
+    MuJoCo {
+        /// The scene file.
+        file: String,
+        /// MuJoCo's message.
+        message: String,
+    },
+    /// A command vector of the wrong length.
+    #[error("expected {expected} arm joint velocities (model order of the arm joints), got {got}")]
+    CommandLength {
+        /// Number of arm joints of the model.
+        expected: usize,
+        /// Length given.
+        got: usize,
+    },
+}
+
+/// A model joint as MuJoCo holds it.
+#[derive(Debug, Clone, Copy)]
+struct JointIo {
+    qpos: usize,
+    dof: usize,
+    actuator: usize,
+}
+
+/// A scripted push, resolved to a MuJoCo body.
+#[derive(Debug, Clone, Copy)]
+struct Push {
+    body: usize,
+    /// Point of application in the body frame.
+    point: Point3<f64>,
+    force: Vector3<f64>,
+    start_s: f64,
+    end_s: f64,
+}
+
+/// A MuJoCo world built from a scene. One [`World::step`] advances one `timestep_s`; the skin and
+/// the LIDAR are sampled during the steps at their own rates (and once at construction).
+pub struct World {
+    scene: Scene,
+    data: MjData<Box<MjModel>>,
+    /// Per model joint: its MuJoCo addresses when it moves (None: frozen).
+    joints: Vec<Option<JointIo>>,
+    /// Model indices of the arm joints (all but the base joints), in model order.
+    arm: Vec<usize>,
+    /// Moving base joints (x, y, yaw), model indices.
+    base: Option<[usize; 3]>,
+    twist: [f64; 3],
+    pushes: Vec<Push>,
+    /// Mocap index of each scene person.
+    persons: Vec<usize>,
+    skin: Option<SkinSensor>,
+    lidar: Option<Lidar>,
+    steps: u64,
+    skin_every: u64,
+    lidar_every: u64,
+    q: Vec<f64>,
+    qd: Vec<f64>,
+}
+
+/// Routes MuJoCo's messages to the `log` crate once per process, instead of MUJOCO_LOG.TXT in
+/// the working directory.
+fn quiet_mujoco_log() {
+    static ONCE: Once = Once::new();
+    // SAFETY: installs a process-wide callback once; MuJoCo reads it only when it logs.
+    ONCE.call_once(|| unsafe { install_logging_hook() });
+}
+
+fn steps_per(rate_hz: f64, timestep_s: f64) -> u64 {
+    // Scene validation guarantees a whole number.
+    (1.0 / (rate_hz * timestep_s)).round() as u64
+}
+
+impl World {
+    /// Loads the scene file and builds its world.
+    pub fn from_scene_file(path: &Path) -> Result<World, WorldError> {
+        Self::from_scene(Scene::load(path)?)
+    }
+
+    /// Builds the world of a loaded scene, at its initial state (kinematics, skin and LIDAR
+    /// evaluated at t = 0).
+    pub fn from_scene(scene: Scene) -> Result<World, WorldError> {
+        quiet_mujoco_log();
+        let file = scene.file.clone();
+        let xml = scene_xml(&scene).map_err(|source| WorldError::Mjcf { file: file.clone(), source })?;
+        let mj = MjModel::from_xml_string(&xml).map_err(|e| WorldError::MuJoCo {
+            file,
+            message: e.to_string(),
+        })?;
+        let model = &scene.model;
+        let body = |name: &str| mj.name_to_id(MjtObjBase::mjOBJ_BODY, name).expect("generated body");
+        let joints = (0..model.nv())
+            .map(|j| {
+                let name = &model.joint_names()[j];
+                let id = mj.name_to_id(MjtObjBase::mjOBJ_JOINT, name)?;
+                Some(JointIo {
+                    qpos: mj.jnt_qposadr()[id] as usize,
+                    dof: mj.jnt_dofadr()[id] as usize,
+                    actuator: mj.name_to_id(MjtObjBase::mjOBJ_ACTUATOR, name).expect("actuator per joint"),
+                })
+            })
+            .collect();
+        let arm = (0..model.nv())
+            .filter(|&j| !BASE_JOINTS.contains(&model.joint_names()[j].as_str()))
+            .collect();
+        let pushes = scene
+            .spec
+            .pushes
+            .iter()
+            .map(|p| {
+                let (b, placement) = match (&p.object, &p.link) {
+                    (Some(o), _) => (body(o), Isometry3::identity()),
+                    (None, Some(link)) => {
+                        let f = FrameRef::new(model, &mj, model.frame_index(link).expect("validated link"));
+                        (f.body, f.placement)
+                    }
+                    (None, None) => unreachable!("validated: object or link"),
+                };
+                Push {
+                    body: b,
+                    point: placement * Point3::from(p.point_m),
+                    force: Vector3::from(p.force_n),
+                    start_s: p.start_s,
+                    end_s: p.end_s,
+                }
+            })
+            .collect();
+        let persons = scene
+            .spec
+            .persons
+            .iter()
+            .map(|p| mj.body_mocapid()[body(&p.name)] as usize)
+            .collect();
+        let skin = SkinSensor::new(&scene, &mj);
+        let lidar = Lidar::new(&scene, &mj);
+        let spec = &scene.spec;
+        let skin_every = spec.skin.as_ref().map_or(0, |s| steps_per(s.rate_hz, spec.timestep_s));
+        let lidar_every = spec.lidar.as_ref().map_or(0, |l| steps_per(l.rate_hz, spec.timestep_s));
+        let n = model.nv();
+        let mut world = World {
+            base: scene.moving_base(),
+            data: MjData::new(Box::new(mj)),
+            joints,
+            arm,
+            twist: [0.0; 3],
+            pushes,
+            persons,
+            skin,
+            lidar,
+            steps: 0,
+            skin_every,
+            lidar_every,
+            q: scene.q0.clone(),
+            qd: vec![0.0; n],
+            scene,
+        };
+        for (j, io) in world.joints.iter().enumerate() {
+            if let Some(io) = io {
+                world.data.qpos_mut()[io.qpos] = world.scene.q0[j];
+            }
+        }
+        world.apply_inputs();
+        world.data.forward();
+        world.sample_sensors();
+        Ok(world)
+    }
+
+    /// The scene the world was built from.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// MuJoCo's model (read-only: for inspection, rendering, tests).
+    pub fn mj_model(&self) -> &MjModel {
+        self.data.model()
+    }
+
+    /// MuJoCo's data (read-only).
+    pub fn mj_data(&self) -> &MjData<Box<MjModel>> {
+        &self.data
+    }
+
+    /// Simulation time \[s\].
+    pub fn time(&self) -> f64 {
+        self.data.ffi().time
+    }
+
+    /// Joint positions in skin_core's model order (frozen joints: their fixed value).
+    pub fn q(&self) -> &[f64] {
+        &self.q
+    }
+
+    /// Joint velocities in skin_core's model order (frozen joints: 0).
+    pub fn qd(&self) -> &[f64] {
+        &self.qd
+    }
+
+    /// Model indices of the arm joints, the order of [`Self::set_arm_velocity_commands`].
+    pub fn arm_joints(&self) -> &[usize] {
+        &self.arm
+    }
+
+    /// Commands the arm joint velocities \[rad/s or m/s\], one per arm joint in model order (as
+    /// skin_core's resolver gives them); commands of frozen joints are ignored. The servos clamp
+    /// to the URDF velocity limits. Held until the next call.
+    pub fn set_arm_velocity_commands(&mut self, qd: &[f64]) -> Result<(), WorldError> {
+        if qd.len() != self.arm.len() {
+            return Err(WorldError::CommandLength {
+                expected: self.arm.len(),
+                got: qd.len(),
+            });
+        }
+        for (&j, &v) in self.arm.iter().zip(qd) {
+            if let Some(io) = self.joints[j] {
+                self.data.ctrl_mut()[io.actuator] = v;
+            }
+        }
+        Ok(())
+    }
+
+    /// Commands the base twist `(vx [m/s], vy [m/s], wz [rad/s])` in the BASE frame; ignored when
+    /// the scene freezes the base. Held until the next call; turned into world-frame joint
+    /// velocities at every step from the current yaw.
+    pub fn set_base_twist(&mut self, twist: [f64; 3]) {
+        self.twist = twist;
+    }
+
+    /// The skin's last sample, indexed like the scene layout's cells (None: no skin).
+    pub fn skin(&self) -> Option<&SkinSensor> {
+        self.skin.as_ref()
+    }
+
+    /// The skin's last readings (empty without skin).
+    pub fn skin_readings(&self) -> &[CellReading] {
+        self.skin.as_ref().map_or(&[], |s| s.readings())
+    }
+
+    /// The LIDAR's last scan (None: no LIDAR).
+    pub fn lidar(&self) -> Option<&Lidar> {
+        self.lidar.as_ref()
+    }
+
+    /// World pose of a robot frame (URDF link index of the scene's model) at the current state.
+    pub fn frame_pose(&self, frame: usize) -> Isometry3<f64> {
+        FrameRef::new(&self.scene.model, self.data.model(), frame).world_pose(&self.data)
+    }
+
+    /// World position of a scene object or person (MuJoCo body by name), None if unknown.
+    pub fn body_position(&self, name: &str) -> Option<[f64; 3]> {
+        let b = self.data.model().name_to_id(MjtObjBase::mjOBJ_BODY, name)?;
+        Some(self.data.xpos()[b])
+    }
+
+    /// Advances one timestep: scripted inputs at the current time, `mj_step`, the state, then the
+    /// skin and the LIDAR when their periods come round.
+    pub fn step(&mut self) {
+        self.apply_inputs();
+        self.data.step();
+        self.steps += 1;
+        self.read_state();
+        self.sample_due_sensors();
+    }
+
+    /// Samples the skin and scans with the LIDAR now, at the current state (the steps do it at
+    /// their rates).
+    pub fn sample_sensors(&mut self) {
+        if let Some(skin) = &mut self.skin {
+            skin.sample(&mut self.data);
+        }
+        if let Some(lidar) = &mut self.lidar {
+            lidar.scan(&mut self.data);
+        }
+    }
+
+    /// Base twist to joint velocities, pushes and persons at the current time.
+    fn apply_inputs(&mut self) {
+        if let Some([x, y, yaw]) = self.base {
+            let (ix, iy, iw) = (self.io(x), self.io(y), self.io(yaw));
+            let (s, c) = self.data.qpos()[iw.qpos].sin_cos();
+            let [vx, vy, wz] = self.twist;
+            let ctrl = self.data.ctrl_mut();
+            ctrl[ix.actuator] = c * vx - s * vy;
+            ctrl[iy.actuator] = s * vx + c * vy;
+            ctrl[iw.actuator] = wz;
+        }
+        let t = self.time();
+        for f in self.data.xfrc_applied_mut() {
+            *f = [0.0; 6];
+        }
+        for k in 0..self.pushes.len() {
+            let p = self.pushes[k];
+            if t < p.start_s || t >= p.end_s {
+                continue;
+            }
+            // xfrc_applied acts at the body's centre of mass: add the moment of the offset.
+            let pose = body_pose(&self.data, p.body);
+            let com = Vector3::from(self.data.xipos()[p.body]);
+            let torque = ((pose * p.point).coords - com).cross(&p.force);
+            let f = &mut self.data.xfrc_applied_mut()[p.body];
+            for i in 0..3 {
+                f[i] += p.force[i];
+                f[3 + i] += torque[i];
+            }
+        }
+        for (k, person) in self.scene.spec.persons.iter().enumerate() {
+            let [x, y] = person.position(t);
+            self.data.mocap_pos_mut()[self.persons[k]] = [x, y, self.scene.spec.floor_z_m];
+        }
+    }
+
+    fn io(&self, j: usize) -> JointIo {
+        self.joints[j].expect("a moving joint")
+    }
+
+    fn read_state(&mut self) {
+        let (qpos, qvel) = (self.data.qpos(), self.data.qvel());
+        for (j, io) in self.joints.iter().enumerate() {
+            if let Some(io) = io {
+                self.q[j] = qpos[io.qpos];
+                self.qd[j] = qvel[io.dof];
+            }
+        }
+    }
+
+    fn sample_due_sensors(&mut self) {
+        if let Some(skin) = &mut self.skin {
+            if self.steps % self.skin_every == 0 {
+                skin.sample(&mut self.data);
+            }
+        }
+        if let Some(lidar) = &mut self.lidar {
+            if self.steps % self.lidar_every == 0 {
+                lidar.scan(&mut self.data);
+            }
+        }
+    }
+}

@@ -1,0 +1,81 @@
+//! The closed loop with the real controller: determinism, metrics.json keys, every scenario's
+//! setup, and the parts of the outcome checks that hold today (see docs/scenarios.md).
+
+use skin_sim::hand_force::HandForceMap;
+use skin_sim::runner::RunTarget;
+use skin_sim::scenario::{self, SCENARIOS};
+use skin_sim::scene::RunOverrides;
+
+fn run(name: &str, seconds: f64) -> skin_sim::report::RunReport {
+    let target = RunTarget::from(scenario::find(name).expect("a scenario"));
+    let overrides = RunOverrides { duration_s: Some(seconds), ..RunOverrides::default() };
+    target.run(&overrides, |_| {}).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+#[test]
+fn same_seed_gives_a_bit_identical_record() {
+    // Noise on: the seed must fix every sample.
+    let target = RunTarget::from(scenario::find("force_tracking_interaction").unwrap());
+    let overrides = RunOverrides { duration_s: Some(1.0), seed: Some(7), ..RunOverrides::default() };
+    // Debug prints every f64 exactly (shortest round-trip form) and NaN as NaN, which `==` would
+    // call unequal to itself (no force reference before 5 s).
+    let record = |o: &RunOverrides| format!("{:?}", target.run(o, |_| {}).unwrap().record.without_timing());
+    let a = record(&overrides);
+    assert!(a.contains("t_s: 0.992"), "125 cycles at 125 Hz");
+    assert!(a == record(&overrides), "two runs with seed 7 differ");
+    assert!(a != record(&RunOverrides { seed: Some(8), ..overrides }), "the seed changes the noise");
+}
+
+#[test]
+fn metrics_json_has_the_keys_of_each_paper() {
+    let always = ["realtime_factor", "sim_duration_s", "max_joint_speed_rad_s", "control_cycle_us_p50", "arrangement_switches"];
+    let paper000 = ["goal_reached", "goal_error_m", "max_contact_force_intentional_n", "eps_c_n", "hard_contact_recovery_s"];
+    let paper003 = ["force_mean_n", "rms_force_error_n", "rms_force_error_interaction_n"];
+    for (name, keys) in [("intentional_contact", &paper000[..]), ("poster_phrc", &paper003[..])] {
+        let report = run(name, 0.5);
+        let json: serde_json::Value = serde_json::to_value(&report.metrics).unwrap();
+        for key in always.iter().chain(keys) {
+            assert!(json.get(key).is_some(), "{name}: metrics.json lacks `{key}`: {json}");
+        }
+        assert!(json["arrangement_switches"].is_array());
+    }
+}
+
+#[test]
+fn every_scenario_builds_and_runs_without_a_safe_stop() {
+    for s in &SCENARIOS {
+        let report = run(s.name, 0.5);
+        assert_eq!(report.metrics.faulted_cycles, 0, "{}: {:?}", s.name, report.record.cycles.iter().find_map(|c| c.fault.clone()));
+        let rate = report.record.control_rate_hz;
+        assert_eq!(report.record.cycles.len(), (0.5 * rate).round() as usize, "{}", s.name);
+    }
+}
+
+#[test]
+fn intentional_contact_reaches_its_goal() {
+    // The whole scene (20 s simulated, about 1 s here). The contact-force checks of this
+    // scenario do not hold yet (docs/scenarios.md); the goal and the fault-free run do.
+    let report = run("intentional_contact", 20.0);
+    let goal = report.metrics.goal.as_ref().expect("a scene with a goal");
+    assert!(goal.goal_reached, "goal error {} m", goal.goal_error_m);
+    assert!(report.checks.iter().any(|c| c.name == "goal reached" && c.passed));
+}
+
+#[test]
+fn the_hand_force_map_is_n_cells_sharing_the_force() {
+    let target = RunTarget::from(scenario::find("poster_phrc").unwrap());
+    let config = skin_core::controller::ControllerConfig::load(&target.controller).unwrap();
+    let map = HandForceMap::new(&config).expect("TOMM's palm has skin");
+    assert_eq!(map.cells(), 8, "the palm face of config/skin/tomm.yaml");
+    let f = config.skin.force;
+    for force in [0.5, 4.0, 6.0] {
+        assert!((map.signal(force) - 8.0 * f.signal(force / 8.0)).abs() < 1e-12);
+    }
+    assert!(map.signal(4.0) > map.signal(3.0), "monotonic");
+}
+
+#[test]
+fn unknown_targets_are_refused_with_the_scenario_names() {
+    let e = RunTarget::resolve("no_such_scenario", None).unwrap_err();
+    assert!(e.contains("intentional_contact") && e.contains("no_such_scenario"), "{e}");
+}

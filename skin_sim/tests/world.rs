@@ -1,0 +1,141 @@
+//! The generated worlds load and move as commanded; scene files validate; errors name the key.
+
+mod common;
+
+use common::{planar7, run, scene, scenes_dir, tomm_right_and_base, world};
+use mujoco_rs::prelude::*;
+use skin_sim::mjcf::ROBOT_GROUP;
+use skin_sim::{Scene, SceneError, World};
+
+fn actuators(w: &World) -> usize {
+    w.mj_model().ffi().nu as usize
+}
+
+/// Contacts between two robot geoms at the world's current state.
+fn robot_self_contacts(w: &World) -> Vec<(String, String)> {
+    let m = w.mj_model();
+    let name = |g: i32| {
+        let b = m.geom_bodyid()[g as usize];
+        m.id_to_name(MjtObjBase::mjOBJ_BODY, b as usize).unwrap_or("?").to_string()
+    };
+    w.mj_data()
+        .contact()
+        .iter()
+        .filter(|c| [c.geom1, c.geom2].iter().all(|&g| m.geom_group()[g as usize] == ROBOT_GROUP as i32))
+        .map(|c| (name(c.geom1), name(c.geom2)))
+        .collect()
+}
+
+#[test]
+fn tomm_full_subset_and_planar7_load_with_one_servo_per_moving_joint() {
+    let full = world("robot: {urdf: ../../urdf/tomm.urdf}\nduration_s: 1.0\n");
+    assert_eq!(actuators(&full), 15);
+    assert_eq!(full.q().len(), 15);
+    let subset = world(&tomm_right_and_base("", ""));
+    assert_eq!(actuators(&subset), 9);
+    // Frozen joints report their fixed value; kept ones their initial value.
+    let m = &subset.scene().model;
+    assert_eq!(subset.q()[m.joint_index("left_elbow_joint").unwrap()], 0.0);
+    let elbow = subset.q()[m.joint_index("right_elbow_joint").unwrap()];
+    assert!((elbow + 0.924).abs() < 1e-12, "{elbow}");
+    let planar = world(&planar7(""));
+    assert_eq!(actuators(&planar), 7);
+}
+
+#[test]
+fn every_scene_file_loads_without_robot_self_contact() {
+    let mut n = 0;
+    for entry in std::fs::read_dir(scenes_dir()).unwrap() {
+        let path = entry.unwrap().path();
+        let w = World::from_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(robot_self_contacts(&w), Vec::<(String, String)>::new(), "{}", path.display());
+        n += 1;
+    }
+    assert!(n >= 7, "only {n} scene files");
+}
+
+#[test]
+fn a_joint_velocity_command_is_tracked_within_3_control_periods() {
+    let mut w = world(&tomm_right_and_base("", ""));
+    let m = w.scene().model.clone();
+    let elbow = m.joint_index("right_elbow_joint").unwrap();
+    let lift = m.joint_index("right_shoulder_lift_joint").unwrap();
+    let mut cmd = vec![0.0; w.arm_joints().len()];
+    let pos = |j: usize, w: &World| w.arm_joints().iter().position(|&a| a == j).unwrap();
+    cmd[pos(elbow, &w)] = 0.5;
+    cmd[pos(lift, &w)] = -0.3;
+    w.set_arm_velocity_commands(&cmd).unwrap();
+    // 3 periods of the 125 Hz arm interface = 24 ms.
+    run(&mut w, 0.024);
+    assert!((w.qd()[elbow] - 0.5).abs() < 0.025, "elbow {}", w.qd()[elbow]);
+    assert!((w.qd()[lift] + 0.3).abs() < 0.015, "lift {}", w.qd()[lift]);
+    let pan = m.joint_index("right_shoulder_pan_joint").unwrap();
+    assert!(w.qd()[pan].abs() < 0.02, "pan {}", w.qd()[pan]);
+    assert!(w.set_arm_velocity_commands(&[0.0; 3]).is_err());
+}
+
+#[test]
+fn a_base_twist_moves_the_base_in_its_own_frame_when_yawed() {
+    let mut w = world(&tomm_right_and_base(", base_yaw_joint: 1.5707963267948966", ""));
+    w.set_base_twist([0.2, 0.0, 0.0]);
+    run(&mut w, 1.0);
+    let m = w.scene().model.clone();
+    let (x, y) = (m.joint_index("base_x_joint").unwrap(), m.joint_index("base_y_joint").unwrap());
+    // Facing +y, forward is +y: 0.2 m after 1 s, less the servo's lag (~12 ms).
+    assert!(w.q()[x].abs() < 2e-3, "x {}", w.q()[x]);
+    assert!((w.q()[y] - 0.2).abs() < 5e-3, "y {}", w.q()[y]);
+    w.set_base_twist([0.0, 0.0, 0.5]);
+    run(&mut w, 1.0);
+    let yaw = w.q()[m.joint_index("base_yaw_joint").unwrap()];
+    assert!((yaw - (std::f64::consts::FRAC_PI_2 + 0.5)).abs() < 0.02, "yaw {yaw}");
+}
+
+#[test]
+fn the_person_follows_its_path() {
+    let mut w = world(&planar7(
+        "persons:\n  - name: p\n    path: [{t_s: 0.0, xy_m: [3.0, 0.0]}, {t_s: 2.0, xy_m: [1.0, 1.0]}]\n",
+    ));
+    run(&mut w, 1.0);
+    let [x, y, z] = w.body_position("p").unwrap();
+    // Mocap positions are set before each step: at most one step (1 ms at 1.1 m/s) behind.
+    assert!((x - 2.0).abs() < 2e-3 && (y - 0.5).abs() < 2e-3, "({x}, {y})");
+    assert_eq!(z, -0.3);
+    run(&mut w, 2.0);
+    assert_eq!(w.body_position("p").unwrap(), [1.0, 1.0, -0.3]);
+}
+
+fn invalid(yaml: &str) -> String {
+    match Scene::from_yaml_str(yaml, "bad.yaml", &scenes_dir()) {
+        Err(e) => e.to_string(),
+        Ok(_) => panic!("accepted:\n{yaml}"),
+    }
+}
+
+#[test]
+fn scene_errors_name_the_file_and_the_key() {
+    let e = invalid(&planar7("objects:\n  - {name: b, shape: {box: {size_m: [0.1, -0.2, 0.1]}}, xyz: [1, 0, 0]}\n"));
+    assert!(e.starts_with("bad.yaml: `objects[0].shape.box.size_m`"), "{e}");
+    let e = invalid(&planar7("objectz: []\n"));
+    assert!(e.contains("bad.yaml") && e.contains("objectz"), "{e}");
+    let e = invalid("robot: {urdf: ../../urdf/planar7.urdf, joints: [joint1, elbow]}\nduration_s: 1\n");
+    assert!(e.contains("`robot.joints[1]`") && e.contains("elbow"), "{e}");
+    let e = invalid("robot: {urdf: ../../urdf/planar7.urdf, initial: {joint2: 4.0}}\nduration_s: 1\n");
+    assert!(e.contains("`robot.initial.joint2`") && e.contains("limits"), "{e}");
+    let e = invalid(
+        "robot: {urdf: ../../urdf/planar7.urdf}\nduration_s: 1\n\
+         skin: {layout: ../skin/planar7.yaml, params: ../skin_model.yaml, patches: [1, 99]}\n",
+    );
+    assert!(e.contains("`skin.patches[1]`"), "{e}");
+    let e = invalid(&planar7("control_rate_hz: 300\n"));
+    assert!(e.contains("`control_rate_hz`") && e.contains("whole number"), "{e}");
+    let e = invalid(&planar7("pushes: [{link: link3, object: b, force_n: [1, 0, 0], start_s: 0, end_s: 1}]\n"));
+    assert!(e.contains("`pushes[0]`"), "{e}");
+    let e = invalid("robot: {urdf: ../../urdf/nope.urdf}\nduration_s: 1\n");
+    assert!(e.contains("`robot.urdf`"), "{e}");
+    assert!(matches!(
+        Scene::from_yaml_str("robot: {urdf: x}\n", "bad.yaml", &scenes_dir()),
+        Err(SceneError::Yaml(_))
+    ));
+    // A valid scene text passes.
+    scene(&planar7(""));
+}

@@ -10,9 +10,12 @@
 //!   [`schedule`] (goals, force references via [`hand_force`], phases), the [`interaction`]
 //!   periods and the physical contact forces of [`probe`], recorded per cycle in [`record`];
 //! - [`scenario`], [`runner`], [`metrics`], [`outcome`], [`report`]: the named scenarios of the
-//!   papers, a run from scene to report, `metrics.json`, the outcome checks, the summary.
+//!   papers, a run from scene to report, `metrics.json`, the outcome checks, the summary;
+//! - [`plot`] and [`bag`]: figures in the papers' style and rosbag2 MCAP files; [`outputs`]
+//!   turns a run into `figure.png` and `run.mcap`.
 #![warn(missing_docs)]
 
+pub mod bag;
 pub mod closed_loop;
 mod frames;
 pub mod hand_force;
@@ -22,6 +25,8 @@ pub mod metrics;
 pub mod mjcf;
 pub mod noise;
 pub mod outcome;
+pub mod outputs;
+pub mod plot;
 pub mod probe;
 pub mod record;
 pub mod report;
@@ -34,5 +39,3 @@ pub mod world;
 
 pub use scene::{Scene, SceneError};
 pub use world::{World, WorldError};
-pub mod bag;
-pub mod plot;

@@ -23,6 +23,8 @@ pub struct CycleRecord {
     pub mode: Mode,
     /// `χ` of paper 000 eq. (10)-(11), 0 outside a blend.
     pub blend: f64,
+    /// Fusion weight `w(t)` of paper 003 eq. (6) the skin was fused with.
+    pub fusion_weight: f64,
     /// The supervisor's signals: ee speed, `‖F_d‖`, skin contact force `‖F_c‖`, goal error.
     pub signals: SupervisorInput,
     /// `‖τ*‖` \[N m\].
@@ -74,6 +76,10 @@ pub struct RunRecord {
     pub timestep_s: f64,
     /// Seed of the sensor noise.
     pub seed: u64,
+    /// The supervisor's speed threshold `ε_v` \[m/s\] (paper 000 Table I).
+    pub eps_v_mps: f64,
+    /// The supervisor's contact force limit `ε_c` \[N\] (paper 000 Table I).
+    pub eps_c_n: f64,
     /// One entry per control cycle, in time order.
     pub cycles: Vec<CycleRecord>,
     /// Arrangement switches in time order.

@@ -94,6 +94,7 @@ impl Controller {
             fault: None,
             mode: supervisor.mode(),
             blend: 0.0,
+            fusion_weight: config.skin.fusion.weight_force,
             signals: SupervisorInput::default(),
             torque_norm: 0.0,
         };
@@ -274,6 +275,7 @@ impl Controller {
 
         // 2. skin: fused with w(t), patch wrenches, hand signals
         self.fusion.weight_force = arrangement.fusion_weight;
+        self.output.fusion_weight = arrangement.fusion_weight;
         let layout = &self.config.layout;
         aggregate_patches(layout, input.cells, &self.fusion, &mut self.wrenches).map_err(stage("skin aggregation"))?;
         let data = &self.data;

@@ -73,6 +73,8 @@ pub struct ControllerOutput {
     /// `χ` of paper 000 eq. (10)-(11): the weight of the previous arrangement's torque (0: no
     /// blend in progress).
     pub blend: f64,
+    /// Fusion weight `w(t)` of paper 003 eq. (6) the skin was fused with this cycle.
+    pub fusion_weight: f64,
     /// The signals the supervisor decided on (ee speed, `‖F_d‖` at the nominal range, `‖F_c‖`,
     /// goal error; the goal error is NaN without a goal).
     pub signals: SupervisorInput,

@@ -4,11 +4,12 @@
 //! summary and writes `metrics.json` and `summary.txt` into `--out`; the exit code is non-zero
 //! when an outcome check fails.
 
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use skin_sim::outputs::{FigurePng, RunBag};
 use skin_sim::report::{write_all, MetricsJson, RunOutput, SummaryText};
 use skin_sim::runner::RunTarget;
 use skin_sim::scenario::SCENARIOS;
@@ -56,24 +57,24 @@ enum Command {
 
 /// The products of a run. The figure and the bag writers are added here.
 fn outputs() -> Vec<Box<dyn RunOutput>> {
-    vec![Box::new(MetricsJson), Box::new(SummaryText)]
+    vec![Box::new(MetricsJson), Box::new(SummaryText), Box::new(FigurePng), Box::new(RunBag)]
 }
 
-/// A progress line on stderr, redrawn at most every 2 % of the run.
+/// A progress line on stderr, redrawn at most every 2 % of the run on a terminal (every 25 %
+/// in a log, where carriage returns do not redraw).
 fn progress_line(name: String, duration_s: Option<f64>) -> impl FnMut(f64) {
     let mut shown = -1.0;
+    let step = if std::io::stderr().is_terminal() { 0.02 } else { 0.25 };
     move |done: f64| {
-        if done - shown < 0.02 && done < 1.0 {
+        if done - shown < step && done < 1.0 {
             return;
         }
         shown = done;
         let width = 30;
         let bar = (done * width as f64) as usize;
         let sim = duration_s.map_or(String::new(), |d| format!(" {:.1}/{d:.0} s", done * d));
-        eprint!("\r{name} [{}{}] {:3.0} %{sim}", "#".repeat(bar), " ".repeat(width - bar), 100.0 * done);
-        if done >= 1.0 {
-            eprintln!();
-        }
+        let end = if done >= 1.0 || step > 0.02 { "\n" } else { "" };
+        eprint!("\r{name} [{}{}] {:3.0} %{sim}{end}", "#".repeat(bar), " ".repeat(width - bar), 100.0 * done);
         let _ = std::io::stderr().flush();
     }
 }

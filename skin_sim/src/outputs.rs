@@ -1,0 +1,154 @@
+//! The run's picture and bag: `figure.png` in the style of the paper's figures and `run.mcap`, a
+//! rosbag2 MCAP of the topics the ROS graph carries during the run (readable by `rosbags`).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use skin_core::supervisor::Mode;
+
+use crate::bag::msgs::{
+    Arrangement, Clock, ControllerState, Float64MultiArray, Header, JointState, Time, Twist, Vector3,
+};
+use crate::bag::BagWriter;
+use crate::plot::{intervals_where, paper000_figure, paper003_figure, Paper000Signals, Paper003Signals};
+use crate::record::{CycleRecord, RunRecord};
+use crate::report::{RunOutput, RunReport};
+
+/// `figure.png`: paper 000's panels (arrangement, ee speed, proximity and contact force, torque)
+/// for a paper 000 scenario, paper 003's force-tracking panels for a force scenario.
+pub struct FigurePng;
+
+fn column(cycles: &[CycleRecord], f: impl Fn(&CycleRecord) -> f64) -> Vec<f64> {
+    cycles.iter().map(f).collect()
+}
+
+impl RunOutput for FigurePng {
+    fn write(&self, report: &RunReport, dir: &Path) -> anyhow::Result<PathBuf> {
+        let path = dir.join("figure.png");
+        let r = &report.record;
+        let c = &r.cycles;
+        let t = column(c, |c| c.t_s);
+        let interaction: Vec<bool> = c.iter().map(|c| c.interaction).collect();
+        let interactions = intervals_where(&t, &interaction);
+        let scene = Path::new(&r.scene_file).file_name().map_or_else(|| r.scene_file.clone(), |f| f.to_string_lossy().into_owned());
+        let title = format!("{} (seed {}, {})", r.name, r.seed, scene);
+        let figure = if report.metrics.force.is_some() {
+            let phase: Vec<usize> = c.iter().map(|c| usize::from(c.mode == Mode::Contact)).collect();
+            let base_speed = column(c, |c| c.base_twist[0].hypot(c.base_twist[1]));
+            paper003_figure(
+                &title,
+                &Paper003Signals {
+                    t: &t,
+                    force_desired: &column(c, |c| c.force_reference_n),
+                    force_measured: &column(c, |c| c.hand_force_n),
+                    phase: &phase,
+                    fusion_weight: &column(c, |c| c.fusion_weight),
+                    base_speed: &base_speed,
+                    tactile: &[],
+                    base_avoidance: &interactions,
+                },
+            )
+        } else {
+            // Table I's (a), (b), (c) are modes 0, 1, 2
+            let arrangement: Vec<usize> = c.iter().map(|c| (c.mode.as_u8() as usize).min(2)).collect();
+            paper000_figure(
+                &title,
+                &Paper000Signals {
+                    t: &t,
+                    arrangement: &arrangement,
+                    ee_speed: &column(c, |c| c.signals.ee_speed_mps),
+                    eps_v: r.eps_v_mps,
+                    avoidance_force: &column(c, |c| c.signals.avoidance_force_n),
+                    contact_force: &column(c, |c| c.link_force_n),
+                    eps_c: r.eps_c_n,
+                    torque_norm: &column(c, |c| c.torque_norm),
+                    pushes: &interactions,
+                },
+            )
+        };
+        figure.save_png(&path)?;
+        Ok(path)
+    }
+}
+
+/// `run.mcap`: per control cycle `/clock`, `/joint_states`, the arm command topics (one per arm:
+/// `/<side>_arm/forward_velocity_controller/commands` for TOMM's `left_`/`right_` joints,
+/// `/arm/...` otherwise), `/base/cmd_vel` (a model with a base), `/controller/state`; and
+/// `/supervisor/arrangement` at the start and at every switch. The skin cells, odometry and scan
+/// are not in the run record, so not in the bag.
+pub struct RunBag;
+
+/// The command topic of an arm joint, by its name's side prefix.
+fn arm_topic(joint: &str) -> &'static str {
+    if joint.starts_with("left_") {
+        "/left_arm/forward_velocity_controller/commands"
+    } else if joint.starts_with("right_") {
+        "/right_arm/forward_velocity_controller/commands"
+    } else {
+        "/arm/forward_velocity_controller/commands"
+    }
+}
+
+fn nanos(t_s: f64) -> u64 {
+    (t_s.max(0.0) * 1e9).round() as u64
+}
+
+fn arrangement_msg(mode: Mode, t_s: f64) -> Arrangement {
+    Arrangement { mode: mode.as_u8(), switch_time: Time::from_nanos(nanos(t_s)), ..Default::default() }
+}
+
+impl RunOutput for RunBag {
+    fn write(&self, report: &RunReport, dir: &Path) -> anyhow::Result<PathBuf> {
+        let path = dir.join("run.mcap");
+        let r: &RunRecord = &report.record;
+        let mut bag = BagWriter::create(&path)?;
+        let topics: Vec<&str> = r.arm_joints.iter().map(|j| arm_topic(j)).collect();
+        let mut distinct = topics.clone();
+        distinct.dedup();
+        let has_base = r.joint_names.iter().any(|j| j == "base_x_joint");
+        if let Some(first) = r.cycles.first() {
+            bag.write("/supervisor/arrangement", nanos(first.t_s), &arrangement_msg(first.mode, first.t_s))?;
+        }
+        let mut switches = r.switches.iter().peekable();
+        for c in &r.cycles {
+            let ns = nanos(c.t_s);
+            let header = Header { stamp: Time::from_nanos(ns), frame_id: String::new() };
+            bag.write("/clock", ns, &Clock { clock: header.stamp })?;
+            let joints = JointState {
+                header: header.clone(),
+                name: r.joint_names.clone(),
+                position: c.q.clone(),
+                velocity: c.qd.clone(),
+                effort: Vec::new(),
+            };
+            bag.write("/joint_states", ns, &joints)?;
+            for topic in &distinct {
+                let data = topics.iter().zip(&c.joint_velocities).filter(|(t, _)| *t == topic).map(|(_, v)| *v).collect();
+                bag.write(topic, ns, &Float64MultiArray { data, ..Default::default() })?;
+            }
+            if has_base {
+                let [vx, vy, wz] = c.base_twist;
+                let twist = Twist { linear: Vector3 { x: vx, y: vy, z: 0.0 }, angular: Vector3 { x: 0.0, y: 0.0, z: wz } };
+                bag.write("/base/cmd_vel", ns, &twist)?;
+            }
+            let s = &c.signals;
+            let state = ControllerState {
+                header,
+                mode: c.mode.as_u8(),
+                blend: c.blend,
+                ee_speed: s.ee_speed_mps,
+                avoidance_force: s.avoidance_force_n,
+                contact_force: s.contact_force_n,
+                torque_norm: c.torque_norm,
+                goal_error: if s.goal_error_m.is_nan() { -1.0 } else { s.goal_error_m },
+                tasks: Vec::new(),
+            };
+            bag.write("/controller/state", ns, &state)?;
+            while let Some(sw) = switches.next_if(|sw| sw.t_s <= c.t_s) {
+                bag.write("/supervisor/arrangement", ns, &arrangement_msg(sw.to, sw.t_s))?;
+            }
+        }
+        bag.finish().with_context(|| format!("finishing {}", path.display()))?;
+        Ok(path)
+    }
+}

@@ -581,3 +581,83 @@ proptest! {
         strict_priority_case("tomm.urdf", &TOMM_LEVELS, &u, &refs)?;
     }
 }
+
+/// Two skin force rows on links 3 and 5 of planar7 (activations `a`) above an acceleration goal.
+fn activated_case(s: &State, a: [f64; 2]) -> (DVector<f64>, DMatrix<f64>) {
+    let n = s.n();
+    let mut skin = TaskLevel::new("avoidance", n, 2);
+    for ((link, f), a) in [("link3", 4.0), ("link5", 2.0)].into_iter().zip(a) {
+        let (jc, _) = s.point(link, [0.1, 0.02, 0.0]);
+        skin.push_directional_activated(&[0.0, 1.0, 0.0], &jc.rows(0, 3), f, a).unwrap();
+    }
+    let (j1, jd1) = s.task("ee", [0.0; 3], &XY);
+    let goal = acc_level("goal", &j1, &jd1, &[0.5, -0.3]);
+    let mut solver = HierarchySolver::new(n, 2, 2, InverseParams::default()).unwrap();
+    let mut tau = DVector::zeros(n);
+    solver.solve(&s.m, [&skin, &goal], None, None, &mut tau).unwrap();
+    (tau, solver.null_space().clone())
+}
+
+#[test]
+fn hierarchy_activated_rows_are_exact_at_the_ends_and_continuous_between() {
+    let s = State::new("planar7.urdf", &P7_BENT, &P7_QD);
+    let n = s.n();
+    // a = 1 for both: the plain force level (augmented projector of both rows)
+    let (t_on, _) = activated_case(&s, [1.0, 1.0]);
+    let mut plain = TaskLevel::new("avoidance", n, 2);
+    for (link, f) in [("link3", 4.0), ("link5", 2.0)] {
+        let (jc, _) = s.point(link, [0.1, 0.02, 0.0]);
+        plain.push_directional(&[0.0, 1.0, 0.0], &jc.rows(0, 3), Reference::Force { f: &[f] }).unwrap();
+    }
+    let (j1, jd1) = s.task("ee", [0.0; 3], &XY);
+    let goal = acc_level("goal", &j1, &jd1, &[0.5, -0.3]);
+    let (t_plain, _) = solve(&s, &[&plain, &goal], None);
+    assert!((&t_on - &t_plain).norm() < 1e-9 * t_plain.norm(), "{t_on} vs {t_plain}");
+    // a = 0 for the second row: the projector is that of the first row alone (its force acts)
+    let skin_only = |a: [f64; 2]| {
+        let mut skin = TaskLevel::new("avoidance", n, 2);
+        for ((link, f), a) in [("link3", 4.0), ("link5", 2.0)].into_iter().zip(a) {
+            let (jc, _) = s.point(link, [0.1, 0.02, 0.0]);
+            skin.push_directional_activated(&[0.0, 1.0, 0.0], &jc.rows(0, 3), f, a).unwrap();
+        }
+        let mut solver = HierarchySolver::new(n, 1, 2, InverseParams::default()).unwrap();
+        let mut tau = DVector::zeros(n);
+        solver.solve(&s.m, [&skin], None, None, &mut tau).unwrap();
+        (tau, solver.null_space().clone())
+    };
+    let (t_skin, n_half) = skin_only([1.0, 0.0]);
+    let mut one = TaskLevel::new("avoidance", n, 2);
+    let (jc3, _) = s.point("link3", [0.1, 0.02, 0.0]);
+    one.push_directional(&[0.0, 1.0, 0.0], &jc3.rows(0, 3), Reference::Force { f: &[4.0] }).unwrap();
+    let mut solver = HierarchySolver::new(n, 1, 2, InverseParams::default()).unwrap();
+    let mut t_one = DVector::zeros(n);
+    solver.solve(&s.m, [&one], None, None, &mut t_one).unwrap();
+    assert!((&n_half - solver.null_space()).norm() < 1e-9);
+    let (jc5, _) = s.point("link5", [0.1, 0.02, 0.0]);
+    let jn5 = jc5.rows(0, 3).transpose() * DVector::from_column_slice(&[0.0, 1.0, 0.0]);
+    assert!((&t_skin - (&t_one + &jn5 * 2.0)).norm() < 1e-9 * t_one.norm(), "the force acts whatever a is");
+    let (t_half, _) = activated_case(&s, [1.0, 0.0]);
+    // the goal is met exactly at the ends (inside the fade a projector is not idempotent, so the
+    // lower level is met only approximately there: the sweep below checks continuity)
+    for a in [[1.0, 1.0], [1.0, 0.0], [0.0, 0.0]] {
+        let (t, _) = activated_case(&s, a);
+        assert!(task_residual(&j1, &jd1, &[0.5, -0.3], &s.qdd(&t)) < 1e-9);
+    }
+    // sweeping a_2 from 1 to 0: the projector moves linearly in a_2 (equal steps), the torque in
+    // steps of the order of the whole change over the number of steps: no jump
+    let steps = 200;
+    let (t_end, _) = activated_case(&s, [1.0, 0.0]);
+    let (n_one, n_end) = (skin_only([1.0, 1.0]).1, skin_only([1.0, 0.0]).1);
+    let (dt_total, dn_total) = ((&t_end - &t_on).norm(), (&n_end - &n_one).norm());
+    assert!(dn_total > 1e-3, "the second row does change the projector");
+    let (mut t_prev, mut n_prev) = (t_on, n_one);
+    for k in 1..=steps {
+        let a2 = 1.0 - k as f64 / steps as f64;
+        let (t, _) = activated_case(&s, [1.0, a2]);
+        let np = skin_only([1.0, a2]).1;
+        assert!((&np - &n_prev).norm() <= 1.000001 * dn_total / steps as f64, "projector step at a = {a2}");
+        assert!((&t - &t_prev).norm() <= 5.0 * dt_total / steps as f64 + 1e-9, "torque step at a = {a2}");
+        (t_prev, n_prev) = (t, np);
+    }
+    assert!((&t_prev - &t_half).norm() < 1e-12);
+}

@@ -215,6 +215,12 @@ impl HierarchySolver {
             } else {
                 mul(self.nproj.as_slice(), jt, &mut self.jbt[..nm], n, n, m);
             }
+            if level.is_activated() {
+                // skin rows with activations: weighted, row by row (any m)
+                self.activated_level(k, level, &mut diag, &mut first)?;
+                self.diagnostics.push(diag);
+                continue;
+            }
             if m > n {
                 // more rows than joints (stacked skin cells): the same level in joint space
                 self.wide_level(k, level, &mut diag, &mut first)?;
@@ -389,6 +395,65 @@ impl HierarchySolver {
                 mul(self.nproj.as_slice(), &self.w[..nn], &mut self.z[..nn], n, n, n);
             }
             sub_mul_nt(self.nproj.as_mut_slice(), &self.z[..nn], &self.lam[..nn], n, n, n);
+            *first = false;
+        }
+        Ok(())
+    }
+
+    /// A force level of activated rows (J̄ᵀ already in `jbt`): the torque is the usual
+    /// `τ̄_k = N_{k−1} J_kᵀ F_k`; the projector takes the rows one at a time, each weighted by its
+    /// activation `a_i` (continuous null-space projection, Dietrich et al. 2012):
+    ///
+    /// ```text
+    /// j̄_i = j_i Nᵀ,  e_i = j̄_i M⁻¹ j̄_iᵀ,  N ← N − a_i f(e_i) (N j̄_iᵀ)(M⁻¹ j̄_iᵀ)ᵀ
+    /// ```
+    ///
+    /// with `N` starting at `N_{k−1}` and including the rows before `i`. With every `a_i = 1` this
+    /// is the augmented projector of the whole level (successive rank-one projections span the
+    /// same space; the damping band `f` of [`InverseParams`] fades dependent rows); a row with
+    /// `a_i = 0` leaves `N` as if it were absent, and `N` is continuous in every `a_i` (in the
+    /// M-metric each factor has eigenvalues `1` and `1 − a_i e_i f(e_i) ∈ [0, 1]`).
+    fn activated_level(&mut self, k: usize, level: &TaskLevel, diag: &mut LevelDiagnostics, first: &mut bool) -> Result<(), HierarchyError> {
+        let (n, m) = (self.nv, level.rows());
+        mul_vec(&self.jbt[..n * m], level.target(), &mut self.tau_bar, n, m);
+        axpy(1.0, &self.tau_bar, &mut self.tau_sum);
+        add_mul_vec(self.minv.as_slice(), &self.tau_bar, &mut self.u_sum, n, n);
+        diag.rows = m;
+        diag.torque_norm = norm(&self.tau_bar);
+        if !self.tau_sum.iter().all(|t| t.is_finite()) {
+            return Err(HierarchyError::Overflow { level: k });
+        }
+        let jt = level.jt_slice();
+        for (i, &a) in level.activation().iter().enumerate() {
+            let row = &jt[i * n..(i + 1) * n];
+            // j̄ᵀ = N j_iᵀ (y), M⁻¹ j̄ᵀ (z), N j̄ᵀ (wt)
+            let (jb, mj, nj) = (&mut self.y[..n], &mut self.z[..n], &mut self.wt[..n]);
+            if *first {
+                jb.copy_from_slice(row);
+            } else {
+                mul_vec(self.nproj.as_slice(), row, jb, n, n);
+            }
+            mul_vec(self.minv.as_slice(), jb, mj, n, n);
+            let e = dot(jb, mj);
+            let f = self.params.filter(e, self.params.threshold(e));
+            if f <= 0.0 {
+                continue;
+            }
+            diag.min_eigenvalue = if diag.rank == 0 { e } else { diag.min_eigenvalue.min(e) };
+            diag.rank += 1;
+            diag.damped += usize::from(e < self.params.damping);
+            if a <= 0.0 {
+                continue;
+            }
+            if *first {
+                nj.copy_from_slice(jb);
+            } else {
+                mul_vec(self.nproj.as_slice(), jb, nj, n, n);
+            }
+            for x in mj.iter_mut() {
+                *x *= a * f;
+            }
+            sub_mul_nt(self.nproj.as_mut_slice(), nj, mj, n, 1, n);
             *first = false;
         }
         Ok(())

@@ -39,6 +39,12 @@ pub enum ReferenceKind {
 /// skin cell), which never allocates. A level with zero rows, or whose Jacobian vanishes,
 /// contributes no torque and leaves the null space unchanged. All rows of a level share one
 /// [`ReferenceKind`], set by the first push after a clear.
+///
+/// A force level may instead be filled with *activated* rows
+/// ([`TaskLevel::push_directional_activated`]): each row carries an activation `a_i ∈ [0, 1]`
+/// that weights its share of the null-space projector (continuous null-space projection after
+/// Dietrich et al. 2012, `docs/hierarchy.md`), so a skin row entering or leaving the sensing
+/// range fades in and out of the projector instead of switching it.
 #[derive(Clone, Debug)]
 pub struct TaskLevel {
     name: String,
@@ -52,6 +58,10 @@ pub struct TaskLevel {
     target: Vec<f64>,
     /// `J̇ q̇` (zeros for force levels).
     jdot_qdot: Vec<f64>,
+    /// Per-row activation `a_i` (1 for rows pushed without one).
+    activation: Vec<f64>,
+    /// Rows were pushed with activations: the solver projects them row by row, weighted.
+    activated: bool,
 }
 
 impl TaskLevel {
@@ -67,6 +77,8 @@ impl TaskLevel {
             jt: vec![0.0; nv * max_rows],
             target: vec![0.0; max_rows],
             jdot_qdot: vec![0.0; max_rows],
+            activation: vec![1.0; max_rows],
+            activated: false,
         }
     }
 
@@ -98,6 +110,7 @@ impl TaskLevel {
     /// Removes all rows (the level then contributes nothing).
     pub fn clear(&mut self) {
         self.rows = 0;
+        self.activated = false;
     }
 
     /// Replaces the level's content by `jacobian` and `reference` (clear + push).
@@ -159,6 +172,36 @@ impl TaskLevel {
         Ok(())
     }
 
+    /// [`TaskLevel::push_directional`] for a force row `f` with activation `a ∈ [0, 1]`: the row's
+    /// torque is `N_{k−1} J_iᵀ f` as always, but it takes only the fraction `a` of its direction
+    /// out of the null space left to lower levels (`a = 0`: as if the row were absent, `a = 1`:
+    /// strict priority). Plain force rows in the same level count as `a = 1`.
+    pub fn push_directional_activated<R: Dim, C: Dim, S: Storage<f64, R, C>>(
+        &mut self,
+        direction: &[f64],
+        jacobian: &Matrix<f64, R, C, S>,
+        f: f64,
+        a: f64,
+    ) -> Result<(), HierarchyError> {
+        if !(0.0..=1.0).contains(&a) {
+            return Err(self.input_error(format!("activation {a} is not in [0, 1]")));
+        }
+        self.push_directional(direction, jacobian, Reference::Force { f: &[f] })?;
+        self.activated = true;
+        self.activation[self.rows - 1] = a;
+        Ok(())
+    }
+
+    /// Whether the rows carry activations ([`TaskLevel::push_directional_activated`]).
+    pub fn is_activated(&self) -> bool {
+        self.activated
+    }
+
+    /// Activations `a_i` of the active rows (all 1 for a level of plain rows).
+    pub fn activation(&self) -> &[f64] {
+        &self.activation[..self.rows]
+    }
+
     /// `J_kᵀ` of the active rows (nv × rows view, no copy).
     pub fn jacobian_transpose(&self) -> DMatrixSlice<'_, f64> {
         DMatrixSlice::from_slice(&self.jt[..self.nv * self.rows], self.nv, self.rows)
@@ -213,6 +256,7 @@ impl TaskLevel {
     }
 
     fn store_reference(&mut self, r0: usize, k: usize, reference: &Reference<'_>) {
+        self.activation[r0..r0 + k].fill(1.0);
         match reference {
             Reference::Acceleration { xdd_star, jdot_qdot } => {
                 self.target[r0..r0 + k].copy_from_slice(xdd_star);

@@ -5,11 +5,15 @@
 //! force `F_di = K (d_range − d_i) ≥ 0`, so the level's torque is `Σ J_v(p_i)ᵀ (−n_i) F_di`
 //! (eq. 4): the link is pushed away from the obstacle, which is outside along `+n_i`.
 //! `d_range` is given per cycle: the supervisor shrinks it (0 disables the task).
+//!
+//! A row enters the null-space projector with an activation that rises smoothly over the outer
+//! `activation_band_m` of the range (`docs/tasks.md`): a cell entering the range changes neither
+//! the torque (`F_di = 0` there) nor the projector of the lower levels by a step.
 
 use nalgebra::Matrix6xX;
 
 use super::params::AvoidanceParams;
-use super::point_rows::push_inward_cell_row;
+use super::point_rows::{push_inward_cell_row, row_activation};
 use super::TaskError;
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
@@ -61,8 +65,8 @@ impl ProximityAvoidance {
     ) -> Result<AvoidanceSummary, TaskError> {
         level.clear();
         let jac = &mut self.jac;
-        self.params.cells_in_range(layout, readings, proximity, range_m, |cell, f| {
-            push_inward_cell_row(model, data, cell, f, jac, level)
+        self.params.cells_in_range(layout, readings, proximity, range_m, |cell, fa| {
+            push_inward_cell_row(model, data, cell, fa, jac, level)
         })
     }
 
@@ -80,14 +84,15 @@ impl ProximityAvoidance {
 }
 
 impl AvoidanceParams {
-    /// Calls `row(cell, F_di)` for every cell within the range (eq. 3) and sums them up.
+    /// Calls `row(cell, (F_di, a_i))` for every cell within the range (eq. 3) and sums them up;
+    /// `a_i` is the row's activation over the outer `activation_band_m` of the range.
     fn cells_in_range(
         &self,
         layout: &ResolvedLayout,
         readings: &[CellReading],
         proximity: &ProximityCharacteristic,
         range_m: f64,
-        mut row: impl FnMut(&ResolvedCell, f64) -> Result<(), TaskError>,
+        mut row: impl FnMut(&ResolvedCell, (f64, f64)) -> Result<(), TaskError>,
     ) -> Result<AvoidanceSummary, TaskError> {
         LengthMismatch::check_readings(layout, readings)?;
         let mut s = AvoidanceSummary { min_distance_m: f64::INFINITY, ..Default::default() };
@@ -96,6 +101,7 @@ impl AvoidanceParams {
             return Ok(s);
         }
         let prox = proximity.prepared();
+        let band = self.activation_band_m.min(range);
         let mut sum_sq = 0.0;
         for (cell, reading) in layout.cells().iter().zip(readings) {
             let p = reading.proximity_signal();
@@ -107,7 +113,7 @@ impl AvoidanceParams {
                 continue;
             }
             let f = linear_repulsion(self.gain_n_per_m, range, d);
-            row(cell, f)?;
+            row(cell, (f, row_activation(range - d, band)))?;
             s.rows += 1;
             sum_sq += f * f;
             s.max_force_n = s.max_force_n.max(f);

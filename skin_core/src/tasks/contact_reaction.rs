@@ -5,12 +5,13 @@
 //! contact: its task force `F_ci = min(gain · F_i, F_max)` acts along `−n_i`, i.e. the row is
 //! `(−n_i)ᵀ J_v(p_i)` with a positive force, so the touched point accelerates away from the object
 //! (`n_iᵀ J_v M⁻¹ τ < 0` at rest), relieving the contact. `F_i` \[N\] comes from the inverse force
-//! characteristic of the cell's force signal, for cells above the activity threshold.
+//! characteristic of the cell's force signal, for cells above the activity threshold. A row's
+//! activation in the null-space projector rises smoothly with `F_i` (`activation_force_n`).
 
 use nalgebra::Matrix6xX;
 
 use super::params::ContactReactionParams;
-use super::point_rows::push_inward_cell_row;
+use super::point_rows::{push_inward_cell_row, row_activation};
 use super::TaskError;
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
@@ -58,8 +59,8 @@ impl ContactReaction {
     ) -> Result<ContactSummary, TaskError> {
         level.clear();
         let jac = &mut self.jac;
-        self.params.contact_cells(layout, readings, force, fusion, |cell, f| {
-            push_inward_cell_row(model, data, cell, f, jac, level)
+        self.params.contact_cells(layout, readings, force, fusion, |cell, fa| {
+            push_inward_cell_row(model, data, cell, fa, jac, level)
         })
     }
 
@@ -76,14 +77,15 @@ impl ContactReaction {
 }
 
 impl ContactReactionParams {
-    /// Calls `row(cell, F_ci)` for every cell in contact (eq. 6) and sums them up.
+    /// Calls `row(cell, (F_ci, a_i))` for every cell in contact (eq. 6) and sums them up; `a_i`
+    /// rises with the measured force up to `activation_force_n`.
     fn contact_cells(
         &self,
         layout: &ResolvedLayout,
         readings: &[CellReading],
         force: &ForceCharacteristic,
         fusion: &FusionParams,
-        mut row: impl FnMut(&ResolvedCell, f64) -> Result<(), TaskError>,
+        mut row: impl FnMut(&ResolvedCell, (f64, f64)) -> Result<(), TaskError>,
     ) -> Result<ContactSummary, TaskError> {
         LengthMismatch::check_readings(layout, readings)?;
         let mut s = ContactSummary::default();
@@ -95,7 +97,7 @@ impl ContactReactionParams {
             }
             let measured = force.force_n(sig);
             let f = (self.gain * measured).min(self.max_force_n);
-            row(cell, f)?;
+            row(cell, (f, row_activation(measured, self.activation_force_n)))?;
             s.rows += 1;
             s.max_force_n = s.max_force_n.max(f);
             s.max_measured_n = s.max_measured_n.max(measured);

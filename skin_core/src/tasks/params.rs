@@ -27,6 +27,10 @@ pub struct AvoidanceParams {
     pub gain_n_per_m: f64,
     /// Nominal `d_range` \[m\]; the supervisor may pass a smaller one per cycle.
     pub range_m: f64,
+    /// Width of the outer band of the range over which a cell's row fades into the null-space
+    /// projector \[m\] (activation 0 at `d_range`, 1 from `d_range − band` inward; capped by the
+    /// current range). 0: rows switch on at once (the projector then jumps at the boundary).
+    pub activation_band_m: f64,
 }
 
 /// Paper 000 eq. (6): contact reaction `F_ci = gain F_i` along the inward normal.
@@ -37,6 +41,9 @@ pub struct ContactReactionParams {
     pub gain: f64,
     /// Saturation of the per-cell task force \[N\].
     pub max_force_n: f64,
+    /// Measured cell force at which a contact row is fully active in the null-space projector
+    /// \[N\] (activation rises smoothly from 0 at no force). 0: rows switch on at once.
+    pub activation_force_n: f64,
 }
 
 /// Paper 003 eq. (9): hand force / distance control on one row.
@@ -162,8 +169,10 @@ impl TaskParams {
         self.goal_orientation.validate("goal_orientation.")?;
         pos("avoidance.", "gain_n_per_m", self.avoidance.gain_n_per_m)?;
         nonneg("avoidance.", "range_m", self.avoidance.range_m)?;
+        nonneg("avoidance.", "activation_band_m", self.avoidance.activation_band_m)?;
         nonneg("contact_reaction.", "gain", self.contact_reaction.gain)?;
         pos("contact_reaction.", "max_force_n", self.contact_reaction.max_force_n)?;
+        nonneg("contact_reaction.", "activation_force_n", self.contact_reaction.activation_force_n)?;
         let h = &self.hand_force;
         pos("hand_force.", "lambda_kg", h.lambda_kg)?;
         nonneg("hand_force.", "k_force_n_per_signal", h.k_force_n_per_signal)?;

@@ -67,17 +67,29 @@ impl PointRows {
 }
 
 /// Pushes one force row `f` [N] along the inward normal `−n` of `cell` (world axes), at the cell:
-/// the row `−nᵀ J_v(p)` of paper 000 eq. (4) / (6). `jac` is scratch space (6 × nv).
+/// the row `−nᵀ J_v(p)` of paper 000 eq. (4) / (6), with activation `a` in the null-space
+/// projector ([`TaskLevel::push_directional_activated`]). `jac` is scratch space (6 × nv).
 pub(crate) fn push_inward_cell_row(
     model: &RobotModel,
     data: &ModelData,
     cell: &ResolvedCell,
-    f: f64,
+    (f, a): (f64, f64),
     jac: &mut Matrix6xX<f64>,
     level: &mut TaskLevel,
 ) -> Result<(), TaskError> {
     let inward = -(data.frame_pose(cell.frame).rotation * cell.normal_link);
     point_jacobian(model, data, cell.frame, &cell.position_link, jac)?;
-    level.push_directional(inward.as_slice(), &jac.fixed_rows::<3>(LINEAR), Reference::Force { f: &[f] })?;
+    level.push_directional_activated(inward.as_slice(), &jac.fixed_rows::<3>(LINEAR), f, a)?;
     Ok(())
+}
+
+/// Activation of a skin row that is `x ≥ 0` past its switching point (inside the sensing range,
+/// above zero force): the smoothstep `s²(3 − 2s)`, `s = x / width` clamped to `[0, 1]`; C¹, 0 at
+/// the switching point, 1 from `width` on (`width = 0`: 1 at once).
+pub(crate) fn row_activation(x: f64, width: f64) -> f64 {
+    if width <= 0.0 {
+        return 1.0;
+    }
+    let s = (x / width).clamp(0.0, 1.0);
+    s * s * (3.0 - 2.0 * s)
 }

@@ -77,7 +77,7 @@ fn shipped_params_load_and_errors_name_file_and_key() {
     assert!(matches!(e, ParamsError::Invalid { .. }));
     let msg = e.to_string();
     assert!(msg.contains("t.yaml") && msg.contains("base_avoidance.alpha_m"), "{msg}");
-    let unknown = text.replace("gain: 1.0", "gain: 1.0\n  extra: 2.0");
+    let unknown = text.replace("gain: 10.0", "gain: 10.0\n  extra: 2.0");
     let msg = TaskParams::from_yaml_str(&unknown, "u.yaml").unwrap_err().to_string();
     assert!(msg.contains("u.yaml") && msg.contains("extra"), "{msg}");
 }
@@ -147,6 +147,32 @@ fn avoidance_rows_magnitude_and_zero_range() {
     let sum = task.update(&s.model, &s.data, &s.layout, &readings, &s.skin.proximity, 0.0, &mut level).unwrap();
     assert_eq!((level.rows(), sum.rows), (0, 0));
     assert_eq!(sum.force_norm_n, 0.0);
+}
+
+#[test]
+fn avoidance_row_fades_in_at_the_range_boundary() {
+    // a cell entering the range: force 0 and activation 0 at d_range, full activation from
+    // d_range − band on, smooth in between (the projector of the lower levels has no step)
+    let s = tomm();
+    let n = s.layout.num_cells();
+    let mut task = ProximityAvoidance::new(s.model.nv(), s.params.avoidance);
+    let mut level = TaskLevel::new("avoid", s.model.nv(), n);
+    let (range, band) = (s.params.avoidance.range_m, s.params.avoidance.activation_band_m);
+    assert!(band > 0.0 && band < range);
+    let mut prev = 0.0;
+    for k in 1..=100 {
+        let d = range - k as f64 * 1e-3;
+        let mut readings = vec![CellReading::uniform(0.0, 0.0); n];
+        readings[5].proximity = s.skin.proximity.signal(d);
+        task.update(&s.model, &s.data, &s.layout, &readings, &s.skin.proximity, range, &mut level).unwrap();
+        assert!(level.is_activated());
+        let a = level.activation()[0];
+        assert!(a >= prev && a - prev < 0.05, "activation {a} after {prev} at d = {d}");
+        if range - d >= band + 1e-6 {
+            assert_eq!(a, 1.0);
+        }
+        prev = a;
+    }
 }
 
 #[test]

@@ -63,7 +63,9 @@ fn volume(shape: &Shape) -> f64 {
 }
 
 /// A fixed (static) or free body with the object's primitives; a free body's mass is spread
-/// over its primitives by volume (uniform density).
+/// over its primitives by volume (uniform density). The geoms have contact priority 1, so the
+/// object's `friction` is the one of its contacts with the floor and the robot (MuJoCo would
+/// otherwise take the larger of the two geoms' coefficients, the floor's 1.0).
 pub(super) fn object_xml(o: &ObjectSpec, xml: &mut String) {
     let parts = primitives(&o.shape);
     let _ = writeln!(
@@ -83,7 +85,7 @@ pub(super) fn object_xml(o: &ObjectSpec, xml: &mut String) {
         let attrs = shape_attrs(shape).expect("objects are primitives");
         let _ = writeln!(
             xml,
-            "      <geom {attrs} {} friction=\"{} 0.005 0.0001\" group=\"{OBJECT_GROUP}\"{density}/>",
+            "      <geom {attrs} {} friction=\"{} 0.005 0.0001\" priority=\"1\" group=\"{OBJECT_GROUP}\"{density}/>",
             pose_attrs(pose),
             o.friction
         );

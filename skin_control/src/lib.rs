@@ -1,11 +1,17 @@
 //! skin_control: the ROS 2 (Jazzy) layer of the system. Nodes are thin: messages are converted to
 //! `skin_core` types in one place ([`convert`]), then the control law in `skin_core` does the work.
+//! The nodes' work without ROS is in [`aggregator`], [`task_controller`], [`supervisor_node`] and
+//! [`sim_bridge`]; their wiring in [`nodes`].
 #![warn(missing_docs)]
 
 pub mod aggregator;
 pub mod convert;
 pub mod markers;
+pub mod nodes;
 pub mod paths;
 pub mod qos;
 pub mod ros_params;
 pub mod shutdown;
+pub mod sim_bridge;
+pub mod supervisor_node;
+pub mod task_controller;

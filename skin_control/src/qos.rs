@@ -11,3 +11,8 @@ pub fn stream() -> QosProfile {
 pub fn latched() -> QosProfile {
     QosProfile::default().reliable().keep_last(1).transient_local()
 }
+
+/// Services: the rmw default (reliable, volatile, keep last 10).
+pub fn services() -> QosProfile {
+    QosProfile::default()
+}

@@ -76,6 +76,7 @@ pub struct StructParams<T> {
     validate: Validate<T>,
     descriptions: &'static [(&'static str, &'static str)],
     read_only: IndexMap<String, (ParameterValue, &'static str)>,
+    start_only: &'static [&'static str],
 }
 
 impl<T: Serialize + DeserializeOwned> StructParams<T> {
@@ -93,6 +94,7 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
             validate,
             descriptions,
             read_only: IndexMap::new(),
+            start_only: &[],
         })
     }
 
@@ -108,6 +110,19 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
         self
     }
 
+    /// Marks struct keys that only the start reads: a key equal to an entry, or under an entry
+    /// that ends with `.` (a section). They take overrides at start; set requests are rejected.
+    pub fn with_start_only(mut self, keys: &'static [&'static str]) -> Self {
+        self.start_only = keys;
+        self
+    }
+
+    fn is_start_only(&self, key: &str) -> bool {
+        self.start_only
+            .iter()
+            .any(|k| key == *k || (k.ends_with('.') && key.starts_with(k)))
+    }
+
     /// The current, valid struct.
     pub fn value(&self) -> &T {
         &self.value
@@ -121,6 +136,12 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
     /// The struct with `key` set to `value`, validated; `self` is unchanged.
     pub fn with_value(&self, key: &str, value: &ParameterValue) -> Result<T, ParamError> {
         if self.read_only.contains_key(key) {
+            return Err(ParamError::new(
+                key,
+                "read-only: read at start, restart the node to change it",
+            ));
+        }
+        if self.is_start_only(key) {
             return Err(ParamError::new(
                 key,
                 "read-only: read at start, restart the node to change it",
@@ -525,6 +546,20 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("fusion.activity_threshold"), "{e}");
+    }
+
+    #[test]
+    fn start_only_keys_take_overrides_but_refuse_sets() {
+        let mut s = served().with_start_only(&["proximity.", "fusion.weight_force"]);
+        let mut o = IndexMap::new();
+        o.insert("proximity.range_m".to_string(), Parameter::new(ParameterValue::Double(0.2)));
+        s.apply_overrides(&o).unwrap();
+        assert_eq!(s.value().proximity.range_m, 0.2);
+        for key in ["proximity.range_m", "fusion.weight_force"] {
+            let e = s.set(key, &ParameterValue::Double(0.3)).unwrap_err();
+            assert!(e.reason.starts_with("read-only"), "{e}");
+        }
+        s.set("fusion.activity_threshold", &ParameterValue::Double(0.1)).unwrap();
     }
 
     #[test]

@@ -14,10 +14,13 @@
 //!   display this message type: `/skin/markers` draws the wrenches in the link frames.
 use std::fmt::{self, Write as _};
 
+pub mod control;
+pub mod robot;
+
 use nalgebra::Vector3;
 use r2r::builtin_interfaces::msg::Time;
 use r2r::geometry_msgs::msg::{Point, Vector3 as Vector3Msg};
-use r2r::skin_msgs::msg::{PatchWrench as PatchWrenchMsg, PatchWrenchArray, SkinCellArray};
+use r2r::skin_msgs::msg::{PatchWrench as PatchWrenchMsg, PatchWrenchArray, SkinCell, SkinCellArray};
 use skin_core::skin::aggregate::PatchWrench;
 use skin_core::skin::layout::ResolvedLayout;
 use skin_core::skin::signals::CellReading;
@@ -223,6 +226,20 @@ impl CellBuffer {
             let proximity = signal("proximity", Some(&cell.proximity));
             self.readings[k] = CellReading { force, proximity };
         }
+    }
+}
+
+/// Writes every layout cell's reading into `msg` (the simulation's skin driver): ids from the
+/// layout, signals as the message's float32, acceleration and temperature zero. Reuses `msg`'s
+/// storage.
+pub fn write_cell_array(layout: &ResolvedLayout, readings: &[CellReading], stamp: &Time, msg: &mut SkinCellArray) {
+    msg.header.stamp = stamp.clone();
+    msg.cells.resize_with(readings.len(), SkinCell::default);
+    for ((out, cell), r) in msg.cells.iter_mut().zip(layout.cells()).zip(readings) {
+        out.cell_id = cell.id;
+        out.force.clear();
+        out.force.extend(r.force.iter().map(|&f| f as f32));
+        out.proximity = r.proximity as f32;
     }
 }
 

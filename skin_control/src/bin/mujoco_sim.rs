@@ -1,0 +1,46 @@
+//! `mujoco_sim`: a skin_sim scene on the ROS graph (see `skin_control::nodes::mujoco_sim`).
+use anyhow::{Context as _, Result};
+use clap::Parser;
+use futures::executor::LocalPool;
+use skin_control::nodes::{self, mujoco_sim};
+use skin_control::shutdown;
+
+/// MuJoCo simulation of a scene: publishes /clock, /joint_states, /base/odom, /scan,
+/// /skin/cells, the scene's /goal and /hand_force_reference; applies
+/// <arm ns>/forward_velocity_controller/commands and /base/cmd_vel.
+///
+/// --lockstep steps one control period per received command set (reproducible: run the
+/// task_controller with trigger:=inputs); otherwise it runs in real time. Exits when the scene
+/// (or --duration) is over, or on SIGINT/SIGTERM.
+#[derive(Parser)]
+#[command(
+    version,
+    after_help = "Examples:\n  mujoco_sim --scene intentional_contact --lockstep --duration 2\n  mujoco_sim --scene config/scenes/tomm_movable_obstacles.yaml --realtime-factor 0.5"
+)]
+struct Args {
+    #[command(flatten)]
+    options: mujoco_sim::Options,
+}
+
+fn main() -> Result<()> {
+    let args = Args::parse_from(nodes::cli_args());
+    shutdown::install().context("installing the SIGINT/SIGTERM handler")?;
+    let ctx = r2r::Context::create()?;
+    let mut node = r2r::Node::create(ctx, mujoco_sim::NODE, "")?;
+    let mut pool = LocalPool::new();
+    let mut handle = mujoco_sim::start(&mut node, &pool.spawner(), args.options)?;
+    let mut failure = None;
+    nodes::spin(&mut [&mut node], &mut pool, || match handle.poll() {
+        Ok(done) => done,
+        Err(e) => {
+            failure = Some(e);
+            true
+        }
+    });
+    handle.stop()?;
+    node.spin_once(std::time::Duration::from_millis(50));
+    match failure {
+        Some(e) => Err(e.context("publishing")),
+        None => Ok(()),
+    }
+}

@@ -1,0 +1,35 @@
+//! `priority_supervisor`: paper 000 Table I / paper 003 Table 1 on the ROS graph. Wiring in
+//! `skin_control::nodes::priority_supervisor`, work in `skin_control::supervisor_node`.
+use anyhow::{Context as _, Result};
+use clap::Parser;
+use futures::executor::LocalPool;
+use skin_control::nodes::{self, priority_supervisor};
+use skin_control::shutdown;
+
+/// Priority supervisor: /controller/state in, /supervisor/arrangement out (reliable, transient
+/// local; on every change and every republish_period_s), service /supervisor/set_phase
+/// (skin_msgs/srv/SetPhase; refused with the reason under the intentional_contact policy).
+///
+/// The supervisor configuration comes from the controller setup file (the same one the
+/// task_controller uses: both must agree on task names and arrangements).
+#[derive(Parser)]
+#[command(
+    version,
+    after_help = "ROS arguments go after --ros-args, e.g.\n  priority_supervisor --setup config/controller/tomm_phases.yaml --ros-args -p republish_period_s:=0.5"
+)]
+struct Args {
+    #[command(flatten)]
+    options: priority_supervisor::Options,
+}
+
+fn main() -> Result<()> {
+    let args = Args::parse_from(nodes::cli_args());
+    shutdown::install().context("installing the SIGINT/SIGTERM handler")?;
+    let ctx = r2r::Context::create()?;
+    let mut node = r2r::Node::create(ctx, priority_supervisor::NODE, "")?;
+    let mut pool = LocalPool::new();
+    let handle = priority_supervisor::start(&mut node, &pool.spawner(), args.options)?;
+    nodes::spin(&mut [&mut node], &mut pool, || false);
+    handle.stop();
+    Ok(())
+}

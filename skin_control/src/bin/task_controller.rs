@@ -1,0 +1,41 @@
+//! `task_controller`: the whole-body controller of both papers on the ROS graph. Wiring in
+//! `skin_control::nodes::task_controller`, work in `skin_control::task_controller`; see docs/ros.md.
+use anyhow::{Context as _, Result};
+use clap::Parser;
+use futures::executor::LocalPool;
+use skin_control::nodes::{self, task_controller};
+use skin_control::shutdown;
+
+/// Whole-body skin controller: /joint_states, /base/odom, /scan, /skin/cells, /goal,
+/// /hand_force_reference, /supervisor/arrangement in; <arm ns>/forward_velocity_controller/commands,
+/// /base/cmd_vel, /controller/state out.
+///
+/// Runs on a timer at control_rate_hz (ROS time; sim time with use_sim_time:=true), or once per
+/// complete input set with trigger:=inputs (lockstep simulation). Zero commands until every input
+/// has arrived, when inputs go stale, and on SIGINT/SIGTERM.
+#[derive(Parser)]
+#[command(
+    version,
+    after_help = "ROS arguments go after --ros-args, e.g.\n  task_controller --ros-args --params-file config/ros/task_controller.yaml -p use_sim_time:=true\n  task_controller --setup config/controller/planar7.yaml --ros-args -p trigger:=inputs -p supervisor:=internal"
+)]
+struct Args {
+    #[command(flatten)]
+    options: task_controller::Options,
+}
+
+fn main() -> Result<()> {
+    let args = Args::parse_from(nodes::cli_args());
+    shutdown::install().context("installing the SIGINT/SIGTERM handler")?;
+    let ctx = r2r::Context::create()?;
+    let mut node = r2r::Node::create(ctx, task_controller::NODE, "")?;
+    let mut pool = LocalPool::new();
+    let handle = task_controller::start(&mut node, &pool.spawner(), args.options)?;
+    nodes::spin(&mut [&mut node], &mut pool, || {
+        handle.poll();
+        false
+    });
+    handle.stop();
+    // Let the zero commands leave before the node goes away.
+    node.spin_once(std::time::Duration::from_millis(50));
+    Ok(())
+}

@@ -1,0 +1,125 @@
+//! The nodes' wiring (topics, timers, services, parameters), one module per node, so that a
+//! binary runs one node and `skin_stack` composes them all in one process (one r2r node each,
+//! one executor). Each `start` function creates the node's entities and spawns its tasks on a
+//! single-threaded `LocalPool`; the caller spins the node and runs the pool, then calls the
+//! handle's `stop` (final messages, summary) when SIGINT/SIGTERM arrives.
+use std::path::PathBuf;
+use std::time::Duration;
+
+use anyhow::{Context as _, Result};
+
+use crate::paths;
+
+pub mod mujoco_sim;
+pub mod priority_supervisor;
+pub mod task_controller;
+
+/// Topic names of the graph (docs/ros.md).
+pub mod topics {
+    /// Skin cells (skin_msgs/SkinCellArray).
+    pub const CELLS: &str = "/skin/cells";
+    /// Patch wrenches (skin_msgs/PatchWrenchArray).
+    pub const PATCHES: &str = "/skin/patches";
+    /// Joint states (sensor_msgs/JointState).
+    pub const JOINT_STATES: &str = "/joint_states";
+    /// Base odometry (nav_msgs/Odometry).
+    pub const ODOM: &str = "/base/odom";
+    /// Base LIDAR (sensor_msgs/LaserScan).
+    pub const SCAN: &str = "/scan";
+    /// End-effector goal (geometry_msgs/PoseStamped).
+    pub const GOAL: &str = "/goal";
+    /// Hand force reference in newtons (std_msgs/Float64).
+    pub const FORCE_REFERENCE: &str = "/hand_force_reference";
+    /// Base twist command (geometry_msgs/Twist).
+    pub const CMD_VEL: &str = "/base/cmd_vel";
+    /// Controller state (skin_msgs/ControllerState).
+    pub const CONTROLLER_STATE: &str = "/controller/state";
+    /// Active arrangement (skin_msgs/Arrangement, latched).
+    pub const ARRANGEMENT: &str = "/supervisor/arrangement";
+    /// Phase service (skin_msgs/srv/SetPhase).
+    pub const SET_PHASE: &str = "/supervisor/set_phase";
+    /// Simulation clock (rosgraph_msgs/Clock).
+    pub const CLOCK: &str = "/clock";
+}
+
+/// A start-up setting: the command-line option, else the ROS parameter `key`, else `default`.
+pub fn file_setting(node: &r2r::Node, option: Option<String>, key: &str, default: &str) -> Result<String> {
+    let param: Option<String> = node.get_parameter(key).with_context(|| format!("ROS parameter `{key}`"))?;
+    Ok(option.or(param).unwrap_or_else(|| default.to_string()))
+}
+
+/// [`paths::resolve`] with the setting's name in the error.
+pub fn resolve(setting: &str, what: &str) -> Result<PathBuf> {
+    paths::resolve(setting).map_err(|e| anyhow::anyhow!("{what}: {e}"))
+}
+
+/// The node's ROS clock now, in seconds (sim time when `use_sim_time` is set).
+pub fn ros_now(node: &r2r::Node) -> f64 {
+    let clock = node.get_ros_clock();
+    let mut clock = clock.lock().unwrap();
+    clock.get_now().map(|d| d.as_secs_f64()).unwrap_or(0.0)
+}
+
+/// Logs the first occurrence of each of `N` kinds of problem once (the counts go into the
+/// shutdown summary).
+#[derive(Debug, Clone, Copy)]
+pub struct OnceLog<const N: usize>([bool; N]);
+
+impl<const N: usize> Default for OnceLog<N> {
+    fn default() -> Self {
+        OnceLog([false; N])
+    }
+}
+
+impl<const N: usize> OnceLog<N> {
+    /// True the first time `kind` is seen.
+    pub fn first(&mut self, kind: usize) -> bool {
+        !std::mem::replace(&mut self.0[kind.min(N - 1)], true)
+    }
+}
+
+/// Durations of one stage over many runs (mean and max), for summaries.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct Timing {
+    /// Number of runs.
+    pub count: u64,
+    /// Sum of durations.
+    pub total: Duration,
+    /// Longest.
+    pub max: Duration,
+}
+
+impl Timing {
+    /// Adds one run.
+    pub fn add(&mut self, d: Duration) {
+        self.count += 1;
+        self.total += d;
+        self.max = self.max.max(d);
+    }
+}
+
+impl std::fmt::Display for Timing {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mean = self.total.checked_div(self.count.max(1) as u32).unwrap_or_default();
+        write!(f, "mean {mean:?}, max {:?}", self.max)
+    }
+}
+
+/// The arguments before `--ros-args` (what clap parses; rcl parses the rest).
+pub fn cli_args() -> impl Iterator<Item = String> {
+    std::env::args().take_while(|a| a != "--ros-args")
+}
+
+/// Spins `nodes` and runs `pool` until SIGINT/SIGTERM (or `done()` holds). One node waits in
+/// its wait set (woken by its own traffic); several nodes (r2r has no shared wait set) are
+/// polled: the first waits at most 100 us, the others are only checked, so a message to any
+/// node waits at most ~100 us for its turn.
+pub fn spin(nodes: &mut [&mut r2r::Node], pool: &mut futures::executor::LocalPool, mut done: impl FnMut() -> bool) {
+    let wait = if nodes.len() > 1 { Duration::from_micros(100) } else { Duration::from_millis(5) };
+    while !crate::shutdown::requested() && !done() {
+        for (k, node) in nodes.iter_mut().enumerate() {
+            node.spin_once(if k == 0 { wait } else { Duration::ZERO });
+        }
+        pool.run_until_stalled();
+    }
+}

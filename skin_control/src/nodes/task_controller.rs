@@ -1,0 +1,307 @@
+//! `task_controller`: robot state, skin cells, goal, force reference and arrangement in; arm
+//! joint velocities, base twist and controller state out (`crate::task_controller` does the work).
+use std::cell::RefCell;
+use std::rc::Rc;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context as _, Result};
+use futures::executor::LocalSpawner;
+use futures::task::LocalSpawnExt;
+use futures::{Stream, StreamExt};
+use r2r::geometry_msgs::msg::{PoseStamped, Twist};
+use r2r::nav_msgs::msg::Odometry;
+use r2r::sensor_msgs::msg::{JointState, LaserScan};
+use r2r::skin_msgs::msg::{Arrangement, ControllerState, SkinCellArray};
+use r2r::std_msgs::msg::{Float64, Float64MultiArray};
+use r2r::{ParameterValue, RosParams};
+use skin_core::controller::ControllerConfig;
+
+use super::topics::*;
+use super::{file_setting, resolve, ros_now, OnceLog, Timing};
+use crate::convert::robot::{time_msg, JointIssue};
+use crate::convert::IssueKind;
+use crate::qos;
+use crate::ros_params::StructParams;
+use crate::task_controller::{Outputs, TaskController, TaskControllerParams, Trigger, DESCRIPTIONS, START_ONLY};
+
+/// Node name.
+pub const NODE: &str = "task_controller";
+
+/// Start-up options (the binary's command line; `None`: the ROS parameter, else the default).
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct Options {
+    /// Controller setup file (skin_core::controller::ControllerSetup) [default: config/controller/tomm.yaml; ROS parameter setup_file].
+    #[arg(long, value_name = "FILE")]
+    pub setup: Option<String>,
+}
+
+struct Publishers {
+    arms: Vec<r2r::Publisher<Float64MultiArray>>,
+    base: Option<r2r::Publisher<Twist>>,
+    state: r2r::Publisher<ControllerState>,
+}
+
+impl Publishers {
+    /// Sends `out`; the first failure is returned with the topic.
+    fn send(&self, out: &Outputs, topics: &[String]) -> std::result::Result<(), String> {
+        for ((p, m), t) in self.arms.iter().zip(out.arms).zip(topics) {
+            p.publish(m).map_err(|e| format!("{t}: {e}"))?;
+        }
+        if let (Some(p), Some(m)) = (&self.base, out.base) {
+            p.publish(m).map_err(|e| format!("{CMD_VEL}: {e}"))?;
+        }
+        if let Some(m) = out.state {
+            self.state.publish(m).map_err(|e| format!("{CONTROLLER_STATE}: {e}"))?;
+        }
+        Ok(())
+    }
+}
+
+struct Shared {
+    tc: TaskController,
+    pubs: Publishers,
+    topics: Vec<String>,
+    logger: String,
+    joint_log: OnceLog<6>,
+    cell_log: OnceLog<5>,
+    input_log: OnceLog<6>,
+    publish_failed: bool,
+    zero_cycles: u64,
+    stale: bool,
+    timing: Timing,
+}
+
+impl Shared {
+    fn publish(&mut self, which: impl FnOnce(&mut TaskController) -> Outputs<'_>) {
+        let out = which(&mut self.tc);
+        if let Err(e) = self.pubs.send(&out, &self.topics) {
+            if !std::mem::replace(&mut self.publish_failed, true) {
+                r2r::log_error!(&self.logger, "publishing failed: {e}");
+            }
+        }
+    }
+
+    fn run_cycle(&mut self, t_s: f64, stamp: &r2r::builtin_interfaces::msg::Time) {
+        let start = Instant::now();
+        self.publish(|tc| tc.cycle(t_s, stamp));
+        self.timing.add(start.elapsed());
+        if let Some(f) = self.tc.last_fault() {
+            if self.input_log.first(5) {
+                r2r::log_warn!(&self.logger, "cycle at t = {t_s:.4} s was a safe-stop step: {f} (further ones counted)");
+            }
+        }
+    }
+
+    fn input_error(&mut self, kind: usize, e: impl std::fmt::Display, topic: &str) {
+        if self.input_log.first(kind) {
+            r2r::log_warn!(&self.logger, "{topic}: {e} (message ignored; further ones not logged)");
+        }
+    }
+
+    /// Trigger `inputs`: a cycle when the input set is complete and newer.
+    fn maybe_cycle(&mut self) {
+        if self.tc.params().trigger == Trigger::Inputs {
+            if let Some(stamp) = self.tc.ready_stamp() {
+                let t = crate::convert::robot::time_s(&stamp);
+                self.run_cycle(t, &stamp);
+            }
+        }
+    }
+}
+
+/// The running node: [`TaskControllerHandle::stop`] sends zero commands on every command topic.
+pub struct TaskControllerHandle {
+    shared: Rc<RefCell<Shared>>,
+}
+
+impl TaskControllerHandle {
+    /// Zero commands on every command topic, then the summary in the log.
+    pub fn stop(&self) {
+        let mut s = self.shared.borrow_mut();
+        s.publish(|tc| tc.zero_outputs());
+        let (cycles, faults) = s.tc.counts();
+        r2r::log_info!(
+            &s.logger,
+            "stopping after {cycles} cycles ({faults} safe-stop steps, {} zero-command periods): cycle {}; joint states: {}; cells: {}; zero commands sent on {}",
+            s.zero_cycles,
+            s.timing,
+            s.tc.joint_issues(),
+            s.tc.cell_issues(),
+            s.topics.join(", ")
+        );
+    }
+
+    /// Trigger `inputs`: runs a cycle when a complete, newer input set is buffered. Call after
+    /// every executor pass, so that every message taken in the pass (a goal with the state) is
+    /// in before the cycle.
+    pub fn poll(&self) {
+        self.shared.borrow_mut().maybe_cycle();
+    }
+
+    /// The controller's counts (cycles, safe-stop steps).
+    pub fn counts(&self) -> (u64, u64) {
+        self.shared.borrow().tc.counts()
+    }
+}
+
+fn spawn_sub<M: 'static>(
+    spawner: &LocalSpawner,
+    mut stream: impl Stream<Item = M> + Unpin + 'static,
+    shared: &Rc<RefCell<Shared>>,
+    mut on: impl FnMut(&mut Shared, M) + 'static,
+) -> Result<()> {
+    let shared = shared.clone();
+    spawner.spawn_local(async move {
+        while let Some(msg) = stream.next().await {
+            let mut s = shared.borrow_mut();
+            on(&mut s, msg);
+        }
+    })?;
+    Ok(())
+}
+
+/// Creates the node's parameters, subscriptions, publishers and timer, and spawns its tasks.
+pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> Result<TaskControllerHandle> {
+    let logger = node.logger().to_string();
+    let setup = file_setting(node, options.setup, "setup_file", "config/controller/tomm.yaml")?;
+    let config = ControllerConfig::load(&resolve(&setup, "setup_file")?).context("controller setup")?;
+    let mut params = StructParams::new(TaskControllerParams::defaults(&config), TaskControllerParams::validate, DESCRIPTIONS)?
+        .with_start_only(START_ONLY)
+        .with_read_only("setup_file", ParameterValue::String(setup.clone()), "Controller setup file (read at start)");
+    params
+        .apply_overrides(&node.params.lock().unwrap())
+        .context("ROS parameter overrides (--ros-args -p / --params-file)")?;
+    let initial = params.value().clone();
+    let params = Arc::new(Mutex::new(params));
+    let served: Arc<Mutex<dyn RosParams + Send>> = params.clone();
+    let (param_services, mut param_changes) = node.make_derived_parameter_handler(served).context("declaring the parameters")?;
+    spawner.spawn_local(param_services)?;
+
+    let tc = TaskController::new(config, initial.clone(), ros_now(node)).map_err(|e| anyhow::anyhow!("{setup}: {e}"))?;
+    let topics: Vec<String> = tc.arms().iter().map(|a| a.topic.clone()).collect();
+    let pubs = Publishers {
+        arms: topics.iter().map(|t| node.create_publisher::<Float64MultiArray>(t, qos::stream())).collect::<r2r::Result<_>>()?,
+        base: if tc.has_base() { Some(node.create_publisher::<Twist>(CMD_VEL, qos::stream())?) } else { None },
+        state: node.create_publisher::<ControllerState>(CONTROLLER_STATE, qos::stream())?,
+    };
+    let mut all_topics = topics.clone();
+    if tc.has_base() {
+        all_topics.push(CMD_VEL.into());
+    }
+    r2r::log_info!(
+        &logger,
+        "{setup}: {} joints, {} cells; trigger {:?} at {} Hz, supervisor {:?}; commands on {}",
+        tc.controller().config().model.nv(),
+        tc.controller().config().layout.num_cells(),
+        initial.trigger,
+        initial.control_rate_hz,
+        initial.supervisor,
+        all_topics.join(", ")
+    );
+    let shared = Rc::new(RefCell::new(Shared {
+        tc,
+        pubs,
+        topics: all_topics,
+        logger: logger.clone(),
+        joint_log: OnceLog::default(),
+        cell_log: OnceLog::default(),
+        input_log: OnceLog::default(),
+        publish_failed: false,
+        zero_cycles: 0,
+        stale: false,
+        timing: Timing::default(),
+    }));
+
+    let log = logger.clone();
+    spawner.spawn_local(async move {
+        while let Some((name, value)) = param_changes.next().await {
+            r2r::log_info!(&log, "parameter {name} set to {value:?}");
+        }
+    })?;
+
+    let js = node.subscribe::<JointState>(JOINT_STATES, qos::stream())?;
+    spawn_sub(spawner, js, &shared, |s, msg| {
+        let (log, seen) = (&s.logger, &mut s.joint_log);
+        s.tc.on_joint_states(&msg, |i| {
+            if seen.first(JointIssue::ALL.iter().position(|k| *k == i.kind).unwrap_or(0)) {
+                r2r::log_warn!(log, "{JOINT_STATES}: {i} (further ones are counted, totals at shutdown)");
+            }
+        });
+    })?;
+    if shared.borrow().tc.has_base() {
+        let odom = node.subscribe::<Odometry>(ODOM, qos::stream())?;
+        spawn_sub(spawner, odom, &shared, |s, msg| {
+            if let Err(e) = s.tc.on_odometry(&msg) {
+                s.input_error(0, e, ODOM);
+            }
+        })?;
+    }
+    let cells = node.subscribe::<SkinCellArray>(CELLS, qos::stream())?;
+    spawn_sub(spawner, cells, &shared, |s, msg| {
+        let (log, seen) = (&s.logger, &mut s.cell_log);
+        s.tc.on_cells(&msg, |i| {
+            if seen.first(IssueKind::ALL.iter().position(|k| *k == i.kind).unwrap_or(0)) {
+                r2r::log_warn!(log, "{CELLS}: {i} (further ones are counted, totals at shutdown)");
+            }
+        });
+    })?;
+    if initial.use_scan {
+        let scan = node.subscribe::<LaserScan>(SCAN, qos::stream())?;
+        spawn_sub(spawner, scan, &shared, |s, msg| {
+            if let Err(e) = s.tc.on_scan(&msg) {
+                s.input_error(1, e, SCAN);
+            }
+        })?;
+    }
+    let goal = node.subscribe::<PoseStamped>(GOAL, qos::latched())?;
+    spawn_sub(spawner, goal, &shared, |s, msg| match s.tc.on_goal(&msg) {
+        Ok(()) => r2r::log_info!(&s.logger, "{GOAL}: goal ({:.3}, {:.3}, {:.3})", msg.pose.position.x, msg.pose.position.y, msg.pose.position.z),
+        Err(e) => s.input_error(2, e, GOAL),
+    })?;
+    let force = node.subscribe::<Float64>(FORCE_REFERENCE, qos::latched())?;
+    spawn_sub(spawner, force, &shared, |s, msg| {
+        if let Err(e) = s.tc.on_force_reference(msg.data) {
+            s.input_error(3, e, FORCE_REFERENCE);
+        }
+    })?;
+    let arrangement = node.subscribe::<Arrangement>(ARRANGEMENT, qos::latched())?;
+    spawn_sub(spawner, arrangement, &shared, |s, msg| match s.tc.on_arrangement(&msg) {
+        Ok(true) => r2r::log_info!(&s.logger, "{ARRANGEMENT}: following mode {} {:?}", msg.mode, msg.task_order),
+        Ok(false) => {}
+        Err(e) => s.input_error(4, e, ARRANGEMENT),
+    })?;
+
+    if initial.trigger == Trigger::Timer {
+        let mut timer = node.create_timer(Duration::from_secs_f64(1.0 / initial.control_rate_hz))?;
+        let clock = node.get_ros_clock();
+        let shared = shared.clone();
+        spawner.spawn_local(async move {
+            while timer.tick().await.is_ok() {
+                let now = clock.lock().unwrap().get_now().map(|d| d.as_secs_f64()).unwrap_or(0.0);
+                let timeout = params.lock().unwrap().value().input_timeout_s;
+                let mut s = shared.borrow_mut();
+                match s.tc.input_age(now) {
+                    Some(age) if age <= timeout => {
+                        if std::mem::replace(&mut s.stale, false) {
+                            r2r::log_info!(&s.logger, "inputs fresh again: control resumes");
+                        }
+                        s.run_cycle(now, &time_msg(now));
+                    }
+                    age => {
+                        s.zero_cycles += 1;
+                        if !std::mem::replace(&mut s.stale, true) {
+                            let why = match age {
+                                None => format!("waiting for {}", s.tc.missing().join(", ")),
+                                Some(a) => format!("inputs {a:.3} s old (input_timeout_s = {timeout})"),
+                            };
+                            r2r::log_warn!(&s.logger, "zero commands: {why}");
+                        }
+                        s.publish(|tc| tc.zero_outputs());
+                    }
+                }
+            }
+        })?;
+    }
+    Ok(TaskControllerHandle { shared })
+}

@@ -1,4 +1,5 @@
-# skin_control: `make demo` (main job), `make test` (every test suite), `make bench` (figures).
+# skin_control: `make demo` (main job), `make test` (every test suite), `make bench` (figures),
+# `make study` (speed/accuracy trade-offs: docs/tradeoffs.md).
 # Each target bootstraps what is missing first (scripts/bootstrap: apt, .deps/venv, MuJoCo).
 SHELL := /bin/bash
 .SHELLFLAGS := -eo pipefail -c
@@ -9,13 +10,15 @@ MSGS_STAMP := $(DEPS)/ros/install/share/skin_msgs/package.xml
 MSG_SRCS := $(wildcard skin_msgs/msg/*.msg skin_msgs/srv/*.srv) skin_msgs/CMakeLists.txt skin_msgs/package.xml
 CARGO_PROFILE ?= dev
 
-.PHONY: help bootstrap msgs build test test-rust test-integration run demo bench clean
+.PHONY: help bootstrap msgs build test test-rust test-integration run demo bench study clean
 
 help:
 	@echo "make demo   bootstrap, build, run the main job: the intentional_contact scenario (see README.md)"
 	@echo "make run SCENE=<name>  run one scenario (skin_sim list), outputs in out/<name>/"
 	@echo "make test   bootstrap, build, run every test suite (cargo tests + test/ integration tests)"
 	@echo "make bench  run the benchmarks; figures in out/bench/summary.json"
+	@echo "make study  speed/accuracy study (rate, timestep, skin density, inverse damping): out/study/results.json,"
+	@echo "            docs/tradeoffs.md and docs/tradeoffs/*.png; STUDY_ARGS=--full for the whole grid (long)"
 	@echo "make clean  remove build outputs (keeps .deps; rm -rf .deps for a full reset)"
 
 bootstrap:
@@ -59,6 +62,13 @@ demo: build
 
 bench: build
 	@$(ENV) scripts/bench
+
+# The speed/accuracy study: the default grid runs in ~2-3 min on 2 cores with the debug profile
+# (opt-level 1, shared with `make test`); only skin_sim is built (no ROS messages needed).
+STUDY_ARGS ?=
+study: bootstrap
+	@echo "[make] skin_sim sweep $(STUDY_ARGS)"
+	@$(ENV) cargo run --quiet -p skin_sim --bin skin_sim -- sweep --out out/study --doc docs/tradeoffs.md $(STUDY_ARGS)
 
 clean:
 	cargo clean

@@ -12,7 +12,9 @@
 //! - [`scenario`], [`runner`], [`metrics`], [`outcome`], [`report`]: the named scenarios of the
 //!   papers, a run from scene to report, `metrics.json`, the outcome checks, the summary;
 //! - [`plot`] and [`bag`]: figures in the papers' style and rosbag2 MCAP files; [`outputs`]
-//!   turns a run into `figure.png` and `run.mcap`.
+//!   turns a run into `figure.png` and `run.mcap`;
+//! - [`study`]: the speed/accuracy study over control rate, timestep, skin density and the
+//!   inverse's damping (`skin_sim sweep`, `docs/tradeoffs.md`).
 #![warn(missing_docs)]
 
 pub mod bag;
@@ -35,6 +37,7 @@ pub mod scenario;
 pub mod scene;
 pub mod schedule;
 pub mod skin_sensor;
+pub mod study;
 pub mod world;
 
 pub use scene::{Scene, SceneError};

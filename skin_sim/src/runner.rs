@@ -68,6 +68,12 @@ impl RunTarget {
     pub fn run(&self, overrides: &RunOverrides, progress: impl FnMut(f64)) -> Result<RunReport, LoopError> {
         let mut scene = Scene::load(&self.scene).map_err(crate::world::WorldError::from)?;
         scene.override_run(overrides).map_err(crate::world::WorldError::from)?;
+        self.run_scene(scene, progress)
+    }
+
+    /// Runs `scene`, this target's scene as loaded and possibly changed by the caller (the
+    /// study's variants: sensor rates, a reduced skin layout), for its `duration_s`.
+    pub fn run_scene(&self, scene: Scene, progress: impl FnMut(f64)) -> Result<RunReport, LoopError> {
         let duration = scene.spec.duration_s;
         let closed_loop = ClosedLoop::new(scene.clone(), &self.controller)?;
         let thresholds = closed_loop.controller().config().supervisor.thresholds;

@@ -2,11 +2,13 @@
 //!
 //! `skin_sim list` names the scenarios; `skin_sim run <scenario|scene file>` runs one, prints a
 //! summary and writes `metrics.json` and `summary.txt` into `--out`; the exit code is non-zero
-//! when an outcome check fails.
+//! when an outcome check fails. `skin_sim sweep` runs the speed/accuracy study and generates
+//! `docs/tradeoffs.md` (`make study`).
 
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::time::Instant;
 
 use clap::{Parser, Subcommand};
 use skin_sim::outputs::{FigurePng, RunBag};
@@ -14,6 +16,7 @@ use skin_sim::report::{write_all, MetricsJson, RunOutput, SummaryText};
 use skin_sim::runner::RunTarget;
 use skin_sim::scenario::SCENARIOS;
 use skin_sim::scene::RunOverrides;
+use skin_sim::study::{self, StudyResults, StudyScenario};
 
 #[derive(Parser)]
 #[command(version, about = "Closed-loop MuJoCo scenarios of skin_control (papers 000 and 003)", long_about = None)]
@@ -53,6 +56,38 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Run the speed/accuracy study over control rate, timestep, skin density and the inverse's
+    /// damping; write results.json and generate the document with its figures.
+    Sweep(SweepArgs),
+}
+
+#[derive(clap::Args)]
+struct SweepArgs {
+    /// The full cross product of the axes instead of the default grid (long: ~1000 runs).
+    #[arg(long)]
+    full: bool,
+    /// Scenarios to study, comma-separated [default: intentional_contact, tomm_movable_obstacles,
+    /// force_tracking_base_motion].
+    #[arg(long, value_delimiter = ',')]
+    scenarios: Vec<String>,
+    /// Simulated duration of every run [s] instead of each scenario's study duration.
+    #[arg(long)]
+    duration: Option<f64>,
+    /// Worker threads [default: the machine's cores].
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Output directory: results.json and the variant setup files.
+    #[arg(long, default_value = "out/study")]
+    out: PathBuf,
+    /// The generated document; its figures go into the directory of the same name beside it.
+    #[arg(long, default_value = "docs/tradeoffs.md")]
+    doc: PathBuf,
+    /// Do not run: regenerate the document from this results.json.
+    #[arg(long)]
+    from: Option<PathBuf>,
+    /// No progress lines on stderr.
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// The products of a run. The figure and the bag writers are added here.
@@ -79,12 +114,77 @@ fn progress_line(name: String, duration_s: Option<f64>) -> impl FnMut(f64) {
     }
 }
 
-fn run(args: Command) -> anyhow::Result<bool> {
-    let Command::Run { target, out, controller, duration, control_rate, dt, seed, quiet } = args else {
-        for s in &SCENARIOS {
-            println!("{:28} {}", s.name, s.description);
+/// The study's scenarios: the named ones (or the default set) with their durations.
+fn study_scenarios(args: &SweepArgs) -> anyhow::Result<Vec<StudyScenario>> {
+    let named: Vec<(String, f64)> = if args.scenarios.is_empty() {
+        study::grid::DEFAULT_SCENARIOS.iter().map(|&(n, d)| (n.to_string(), d)).collect()
+    } else {
+        let default = |n: &str| study::grid::DEFAULT_SCENARIOS.iter().find(|s| s.0 == n).map(|s| s.1);
+        args.scenarios.iter().map(|n| (n.clone(), default(n).unwrap_or(20.0))).collect()
+    };
+    named
+        .into_iter()
+        .map(|(name, duration)| {
+            let target = RunTarget::resolve(&name, None).map_err(anyhow::Error::msg)?;
+            Ok(StudyScenario { target, duration_s: args.duration.unwrap_or(duration) })
+        })
+        .collect()
+}
+
+fn sweep(args: SweepArgs) -> anyhow::Result<bool> {
+    let results_file = args.out.join("results.json");
+    let results = match &args.from {
+        Some(from) => StudyResults::load(from)?,
+        None => {
+            let scenarios = study_scenarios(&args)?;
+            let points = study::grid_points(&scenarios, args.full)?;
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let jobs = args.jobs.unwrap_or(cores).max(1);
+            eprintln!("study: {} points over {} scenarios on {jobs} threads ({} build)", points.len(), scenarios.len(), study::profile());
+            let started = Instant::now();
+            let points = study::run(&scenarios, &points, jobs, &args.out.join("variants"), |done, total, r| {
+                if !args.quiet {
+                    eprintln!("{}", study::progress_line(done, total, r, started));
+                }
+            })?;
+            let command = std::iter::once("skin_sim".to_string()).chain(std::env::args().skip(1)).collect::<Vec<_>>().join(" ");
+            let results = StudyResults {
+                command,
+                grid: if args.full { "full" } else { "default" }.into(),
+                profile: study::profile().into(),
+                jobs,
+                cores,
+                wall_time_s: started.elapsed().as_secs_f64(),
+                points,
+            };
+            results.save(&results_file)?;
+            println!("wrote {}", results_file.display());
+            results
         }
-        return Ok(true);
+    };
+    let shown = args.from.as_deref().unwrap_or(&results_file);
+    let files = study::doc::write(&results, shown, &args.doc)?;
+    let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
+    println!("wrote {}", names.join(", "));
+    let failed = results.points.iter().filter(|p| matches!(p.outcome, study::Outcome::Failed { .. })).count();
+    if failed > 0 {
+        eprintln!("study: {failed} points failed to run (see the document)");
+    }
+    Ok(failed == 0)
+}
+
+fn run(args: Command) -> anyhow::Result<bool> {
+    let (target, out, controller, duration, control_rate, dt, seed, quiet) = match args {
+        Command::List => {
+            for s in &SCENARIOS {
+                println!("{:28} {}", s.name, s.description);
+            }
+            return Ok(true);
+        }
+        Command::Sweep(args) => return sweep(args),
+        Command::Run { target, out, controller, duration, control_rate, dt, seed, quiet } => {
+            (target, out, controller, duration, control_rate, dt, seed, quiet)
+        }
     };
     let target = RunTarget::resolve(&target, controller).map_err(anyhow::Error::msg)?;
     let overrides = RunOverrides {

@@ -11,11 +11,11 @@ use plotters::style::{register_font, FontStyle};
 use super::{Content, Figure, Interval, Panel, Tint, TITLE_HEIGHT};
 
 /// Family name the shipped font is registered under (ab_glyph looks fonts up by name).
-const FONT: &str = "sans-serif";
+pub(crate) const FONT: &str = "sans-serif";
 static FONT_TTF: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
 /// Line colours, in order of the lines of a panel (matplotlib's tab10 start).
-const PALETTE: [RGBColor; 6] = [
+pub(crate) const PALETTE: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
@@ -50,7 +50,7 @@ fn err(e: impl std::fmt::Display) -> String {
 }
 
 /// Register the shipped font once per process.
-fn font() -> Result<(), String> {
+pub(crate) fn font() -> Result<(), String> {
     static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
     REGISTERED
         .get_or_init(|| {

@@ -129,6 +129,18 @@ impl Scene {
         })
     }
 
+    /// Replaces the skin layout with `layout` (e.g. fewer cells on the same patches), keeping the
+    /// characteristics and the sensing patches (`skin.patches`).
+    pub fn set_skin_layout(&mut self, layout: &SkinLayout) -> Result<(), SceneError> {
+        let invalid = |r: Rejected| SceneError::Invalid { file: self.file.clone(), key: r.key, reason: r.reason };
+        let patches = self.spec.skin.as_ref().and_then(|s| s.patches.clone());
+        let skin = self.skin.as_mut().ok_or_else(|| invalid(reject("skin", "the scene has no skin to replace")))?;
+        let resolved = layout.resolve(&self.model).map_err(|e| invalid(reject("skin.layout", e.to_string())))?;
+        skin.active = active_cells(&resolved, patches.as_deref()).map_err(invalid)?;
+        skin.layout = resolved;
+        Ok(())
+    }
+
     /// Model indices of the base joints (x, y, yaw) when the base moves in this scene.
     pub fn moving_base(&self) -> Option<[usize; 3]> {
         let idx = BASE_JOINTS.map(|n| self.model.joint_index(n));
@@ -204,13 +216,18 @@ fn load_skin(s: &SkinSpec, dir: &Path, model: &RobotModel) -> Result<SceneSkin, 
         .and_then(|l| l.resolve(model))
         .map_err(|e| reject("skin.layout", e.to_string()))?;
     let params = SkinParams::load(&resolve(dir, &s.params)).map_err(|e| reject("skin.params", e.to_string()))?;
-    let mut active_patch = vec![s.patches.is_none(); layout.patches().len()];
-    for (i, id) in s.patches.iter().flatten().enumerate() {
+    let active = active_cells(&layout, s.patches.as_deref())?;
+    Ok(SceneSkin { layout, params, active })
+}
+
+/// Per cell of `layout`: whether its patch is in `patches` (None: all patches sense).
+fn active_cells(layout: &ResolvedLayout, patches: Option<&[u32]>) -> Result<Vec<bool>, Rejected> {
+    let mut active_patch = vec![patches.is_none(); layout.patches().len()];
+    for (i, id) in patches.iter().copied().flatten().enumerate() {
         let k = layout
             .patch_index(*id)
             .ok_or_else(|| reject(format!("skin.patches[{i}]"), format!("no patch {id} in the layout")))?;
         active_patch[k] = true;
     }
-    let active = layout.cells().iter().map(|c| active_patch[c.patch]).collect();
-    Ok(SceneSkin { layout, params, active })
+    Ok(layout.cells().iter().map(|c| active_patch[c.patch]).collect())
 }

@@ -661,3 +661,40 @@ fn hierarchy_activated_rows_are_exact_at_the_ends_and_continuous_between() {
     }
     assert!((&t_prev - &t_half).norm() < 1e-12);
 }
+
+/// Locked joints (TOMM's base switched off): the solve equals the literal hierarchy on the free
+/// joints' dynamics `M_ff` and Jacobian columns, and the locked joints get no torque.
+#[test]
+fn hierarchy_locked_joints_solve_the_free_joints_exactly() {
+    let model = load("tomm.urdf");
+    let n = model.nv();
+    let (q, qd) = tomm_q(n);
+    let mut data = ModelData::new(&model);
+    update_kinematics(&model, &mut data, &q, &qd).unwrap();
+    let s = State::new("tomm.urdf", &q, &qd);
+    let locked: Vec<bool> = (0..n).map(|j| j < 3).collect(); // base x, y, yaw
+    let free: Vec<usize> = (3..n).collect();
+    let (j1, jd1) = s.task("right_hand", [0.0; 3], &[0, 1, 2]);
+    let (j2, jd2) = s.task("left_hand", [0.0; 3], &[3, 4, 5]);
+    let (x1, x2) = ([0.3, -0.1, 0.2], [0.1, 0.2, -0.3]);
+    let mut l1 = acc_level("right", &j1, &jd1, &x1);
+    let mut l2 = acc_level("left", &j2, &jd2, &x2);
+    l1.lock_joints(&locked);
+    l2.lock_joints(&locked);
+    let mut solver = HierarchySolver::new(n, 4, 6, InverseParams::default()).unwrap();
+    solver.set_locked_joints(&locked).unwrap();
+    let mut tau = DVector::zeros(n);
+    solver.solve_model(&model, &mut data, [&l1, &l2], None, false, &mut tau).unwrap();
+    assert!(tau.rows(0, 3).iter().all(|&t| t == 0.0), "no torque on locked joints: {tau}");
+    let m_ff = s.m.select_rows(&free).select_columns(&free);
+    let want = reference_solve(
+        &m_ff,
+        &[
+            (j1.select_columns(&free), DVector::from_column_slice(&x1) - &jd1, false),
+            (j2.select_columns(&free), DVector::from_column_slice(&x2) - &jd2, false),
+        ],
+        &InverseParams::default(),
+    );
+    let err = (tau.rows(3, n - 3) - &want).amax() / want.amax();
+    assert!(err < 1e-9, "relative difference to the reduced hierarchy {err:e}");
+}

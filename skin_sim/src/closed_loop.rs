@@ -13,7 +13,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use nalgebra::Vector2;
-use skin_core::controller::{Controller, ControllerInput, SetupError};
+use skin_core::controller::{Controller, ControllerConfig, ControllerInput, SetupError};
 use thiserror::Error;
 
 use crate::interaction::Interactions;
@@ -67,9 +67,13 @@ pub struct ClosedLoop {
 
 impl ClosedLoop {
     /// The loop of `scene` with the controller of the setup file `setup`; the controller's robot
-    /// must be the scene's (same joints in the same order).
+    /// must be the scene's (same joints in the same order). The joints the scene freezes are
+    /// locked in the controller (no task uses them: their commands would be dropped).
     pub fn new(scene: Scene, setup: &Path) -> Result<Self, LoopError> {
-        let controller = Controller::from_setup_file(setup, 0.0)?;
+        let mut config = ControllerConfig::load(setup)?;
+        let frozen = scene.model.joint_names().iter().zip(&scene.moving).filter(|(_, &moving)| !moving);
+        config.setup.locked_joints = frozen.map(|(name, _)| name.clone()).collect();
+        let controller = Controller::new(config, 0.0)?;
         let world = World::from_scene(scene)?;
         let scene = world.scene();
         let mismatch = |reason: String| LoopError::Mismatch {

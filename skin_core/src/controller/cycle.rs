@@ -52,6 +52,8 @@ pub struct Controller {
     guidance_patches: Vec<bool>,
     /// Patches that are not hand patches: the body of eq. (13)-(14).
     body_patches: Vec<bool>,
+    /// Joints held still (setup `locked_joints`), per model joint.
+    locked: Vec<bool>,
     goal: Option<Isometry3<f64>>,
     fusion: FusionParams,
     wrenches: Vec<PatchWrench>,
@@ -82,10 +84,18 @@ impl Controller {
         let hand_patches = config.patch_mask("hand_patches", &config.setup.hand_patches)?;
         let guidance_patches = config.patch_mask("guidance_patches", &config.setup.guidance_patches)?;
         let body_patches = hand_patches.iter().map(|h| !h).collect();
+        let mut locked = vec![false; nv];
+        for (i, name) in config.setup.locked_joints.iter().enumerate() {
+            let j = model
+                .joint_index(name)
+                .ok_or_else(|| config.invalid(format!("locked_joints[{i}]"), format!("joint `{name}` is not in {}", model.source())))?;
+            locked[j] = true;
+        }
         let tasks = TaskSet::new(&config, ee)?;
         let max_rows = tasks.levels.iter().map(|l| l.max_rows()).max().unwrap_or(0);
-        let solver = HierarchySolver::new(nv, tasks.levels.len(), max_rows, config.setup.inverse)
+        let mut solver = HierarchySolver::new(nv, tasks.levels.len(), max_rows, config.setup.inverse)
             .map_err(|error| SetupError::Inverse { file: config.source.clone(), error })?;
+        solver.set_locked_joints(&locked).map_err(|error| SetupError::Inverse { file: config.source.clone(), error })?;
         let resolver = Resolver::new(model, config.resolver.clone())
             .map_err(|error| SetupError::Resolver { file: config.setup.resolver.display().to_string(), error })?;
         let supervisor = Supervisor::new(&config.supervisor, t0_s)?;
@@ -107,6 +117,7 @@ impl Controller {
             hand_patches,
             guidance_patches,
             body_patches,
+            locked,
             goal: None,
             fusion: config.skin.fusion,
             wrenches: Vec::with_capacity(config.layout.patches().len()),
@@ -292,13 +303,20 @@ impl Controller {
             sensing_range_m: arrangement.sensing_range_m,
         };
         let order = arrangement.task_order();
+        let any_locked = self.locked.contains(&true);
         for &i in order {
             self.tasks.fill(i, &cx).map_err(stage("task update"))?;
+            if any_locked {
+                self.tasks.levels[i].lock_joints(&self.locked);
+            }
         }
         let has_posture = self
             .tasks
             .posture_torque(order, model, data, &self.config, &self.wrenches, &self.body_patches, input.scan)
             .map_err(stage("posture torque"))?;
+        if has_posture && any_locked {
+            self.tasks.posture.lock_joints(&self.locked);
+        }
         let posture = has_posture.then(|| self.tasks.posture.torque().as_slice());
         let (kinds, levels) = (&self.tasks.kinds, &self.tasks.levels);
         let active = order.iter().filter(|&&i| kinds[i].is_level()).map(|&i| &levels[i]);
@@ -319,6 +337,9 @@ impl Controller {
 
         // 5. admittance resolver
         gravity(model, &mut self.data, &mut self.gravity).map_err(stage("gravity"))?;
+        for (g, _) in self.gravity.iter_mut().zip(&self.locked).filter(|(_, &l)| l) {
+            *g = 0.0; // a locked joint's virtual dynamics stay at rest (its τ* is 0)
+        }
         self.resolver
             .update(self.tau.as_slice(), self.gravity.as_slice(), input.q, input.qd, input.dt_s)
             .map_err(stage("resolver"))?;

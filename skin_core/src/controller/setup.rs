@@ -47,6 +47,10 @@ pub struct ControllerSetup {
     /// Patch ids whose touches guide the hand (paper 003 eq. (11), the arm patches).
     #[serde(default)]
     pub guidance_patches: Vec<u32>,
+    /// Joints held still (e.g. TOMM's base when it is switched off, or a scene that freezes it):
+    /// no task uses them, they get no torque and a zero command.
+    #[serde(default)]
+    pub locked_joints: Vec<String>,
     /// Desired posture `q_post` of eq. (18), model joint order; empty: all zeros.
     #[serde(default)]
     pub posture: Vec<f64>,

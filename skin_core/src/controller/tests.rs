@@ -3,6 +3,7 @@ use std::path::PathBuf;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 use super::*;
+use crate::controller::ControllerConfig;
 use crate::skin::signals::CellReading;
 use crate::supervisor::Mode;
 
@@ -112,6 +113,8 @@ fn setup_errors_name_file_and_key() {
     assert!(e.contains("posture") && e.contains("5 values"), "{e}");
     let e = setup_error("planar7", "damping: 1.0e-3", "damping: -1.0");
     assert!(e.contains("inverse.") && e.contains("damping"), "{e}");
+    let e = setup_error("tomm", "hand_patches: [12]", "hand_patches: [12]\nlocked_joints: [base_x_joint, base_z_joint]");
+    assert!(e.contains("locked_joints[1]") && e.contains("base_z_joint"), "{e}");
     let e = setup_error("tomm", "end_effector:", "end_efector:");
     assert!(e.contains("end_efector"), "unknown keys are errors: {e}");
 }
@@ -123,4 +126,29 @@ fn task_names_map_to_kinds() {
     }
     assert_eq!(TaskKind::from_name("levitate"), None);
     assert!(!TaskKind::Posture.is_level() && TaskKind::Goal.is_level());
+}
+
+#[test]
+fn locked_base_stays_still_while_the_arm_reaches() {
+    let mut config = ControllerConfig::load(&setup("tomm")).unwrap();
+    config.setup.locked_joints = ["base_x_joint", "base_y_joint", "base_yaw_joint"].map(String::from).to_vec();
+    let mut c = Controller::new(config, 0.0).unwrap();
+    let mut q = c.config().setup.posture.clone();
+    let mut qd = vec![0.0; q.len()];
+    let cells = vec![CellReading::default(); c.config().layout.num_cells()];
+    let hand = c.config().model.frame_index("right_hand").unwrap();
+    let mut data = crate::model::ModelData::new(&c.config().model);
+    crate::model::update_kinematics(&c.config().model, &mut data, &q, &qd).unwrap();
+    let goal = data.frame_pose(hand).translation.vector + Vector3::new(0.1, -0.1, 0.05);
+    c.set_goal(Some(Isometry3::from_parts(Translation3::from(goal), UnitQuaternion::identity()))).unwrap();
+    let dt = 0.008;
+    for k in 0..1000 {
+        let out = c.update(&ControllerInput { t_s: k as f64 * dt, dt_s: dt, q: &q, qd: &qd, cells: &cells, scan: &[] });
+        assert_eq!(out.fault, None);
+        assert_eq!(out.commands.base_twist, [0.0; 3], "cycle {k}: the locked base gets a zero command");
+        assert!(c.torque().rows(0, 3).iter().all(|&t| t == 0.0));
+        follow(&c, &mut q, &mut qd, dt);
+    }
+    let e = c.output().signals.goal_error_m;
+    assert!(e < 0.005, "the arm alone reaches the goal in 8 s: error {e} m");
 }

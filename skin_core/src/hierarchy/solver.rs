@@ -86,6 +86,8 @@ pub struct HierarchySolver {
     /// M and C q̇ + g for [`HierarchySolver::solve_model`].
     m_model: DMatrix<f64>,
     bias_model: DVector<f64>,
+    /// Joints held still ([`HierarchySolver::set_locked_joints`]).
+    locked: Vec<bool>,
 }
 
 impl HierarchySolver {
@@ -120,6 +122,7 @@ impl HierarchySolver {
             diagnostics: Vec::with_capacity(max_levels),
             m_model: DMatrix::zeros(n, n),
             bias_model: DVector::zeros(n),
+            locked: vec![false; n],
         })
     }
 
@@ -459,6 +462,18 @@ impl HierarchySolver {
         Ok(())
     }
 
+    /// Marks joints as locked for [`HierarchySolver::solve_model`] (length `nv`): their rows and
+    /// columns of `M` are replaced by the identity's and their bias by 0, so the hierarchy is
+    /// solved on the free joints' dynamics `M_ff` exactly (the levels' Jacobian columns of locked
+    /// joints must be zero too: [`TaskLevel::lock_joints`]); their torque comes out 0.
+    pub fn set_locked_joints(&mut self, locked: &[bool]) -> Result<(), HierarchyError> {
+        if locked.len() != self.nv {
+            return Err(HierarchyError::Dimension { what: "locked joints", expected: self.nv, got: locked.len() });
+        }
+        self.locked.copy_from_slice(locked);
+        Ok(())
+    }
+
     /// [`HierarchySolver::solve`] with `M` and `C q̇ + g` computed from the model at the state of
     /// the last `model::update_kinematics` on `data` (CRBA and RNEA into the solver's own
     /// buffers); `include_bias = false` leaves the bias out.
@@ -483,6 +498,12 @@ impl HierarchySolver {
             crba(model, data, &mut m).map_err(model_error)?;
             if include_bias {
                 bias_forces(model, data, &mut bias).map_err(model_error)?;
+            }
+            for (j, _) in self.locked.iter().enumerate().filter(|(_, &l)| l) {
+                m.row_mut(j).fill(0.0);
+                m.column_mut(j).fill(0.0);
+                m[(j, j)] = 1.0;
+                bias[j] = 0.0;
             }
             self.solve(&m, levels, posture, include_bias.then_some(bias.as_slice()), tau_out)
         };

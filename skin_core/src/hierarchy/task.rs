@@ -223,6 +223,19 @@ impl TaskLevel {
     }
 
     /// `J_kᵀ` storage of the active rows (nv × rows, column-major), for the solver.
+    /// Zeroes the Jacobian columns of the joints marked in `locked` (length `nv`): a locked joint
+    /// (e.g. a base that is switched off) does not move, so no task can use it.
+    pub fn lock_joints(&mut self, locked: &[bool]) {
+        let n = self.nv;
+        for row in self.jt[..n * self.rows].chunks_exact_mut(n) {
+            for (x, &l) in row.iter_mut().zip(locked) {
+                if l {
+                    *x = 0.0;
+                }
+            }
+        }
+    }
+
     pub(crate) fn jt_slice(&self) -> &[f64] {
         &self.jt[..self.nv * self.rows]
     }

@@ -83,6 +83,15 @@ impl Posture {
         Ok(&self.tau)
     }
 
+    /// Zeroes the last update's torque on the joints marked in `locked` (joints held still).
+    pub fn lock_joints(&mut self, locked: &[bool]) {
+        for (t, &l) in self.tau.iter_mut().zip(locked) {
+            if l {
+                *t = 0.0;
+            }
+        }
+    }
+
     /// `τ_c*` of the last update.
     pub fn torque(&self) -> &DVector<f64> {
         &self.tau

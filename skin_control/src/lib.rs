@@ -1,7 +1,7 @@
 //! skin_control: the ROS 2 (Jazzy) layer of the system. Nodes are thin: messages are converted to
 //! `skin_core` types in one place ([`convert`]), then the control law in `skin_core` does the work.
 //! The nodes' work without ROS is in [`aggregator`], [`task_controller`], [`supervisor_node`] and
-//! [`sim_bridge`]; their wiring in [`nodes`].
+//! [`sim_bridge`]; their wiring in [`nodes`]; the bag tool `skin_bag` in [`rosbag`].
 #![warn(missing_docs)]
 
 pub mod aggregator;
@@ -11,6 +11,7 @@ pub mod nodes;
 pub mod paths;
 pub mod qos;
 pub mod ros_params;
+pub mod rosbag;
 pub mod shutdown;
 pub mod sim_bridge;
 pub mod supervisor_node;

@@ -7,6 +7,14 @@ pub fn stream() -> QosProfile {
     QosProfile::default().reliable().keep_last(10)
 }
 
+/// Inputs whose every sample matters (the supervisor's dwell timers count controller states): a
+/// deep reader history, so a node that is descheduled for a while (lockstep simulation runs the
+/// graph several times faster than real time) catches up instead of losing samples; r2r takes
+/// one sample per spin, so the reader history is the only buffer.
+pub fn every_sample() -> QosProfile {
+    QosProfile::default().reliable().keep_last(1000)
+}
+
 /// State that a late joiner must still get (the active arrangement): reliable, transient local.
 pub fn latched() -> QosProfile {
     QosProfile::default().reliable().keep_last(1).transient_local()

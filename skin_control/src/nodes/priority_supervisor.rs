@@ -74,7 +74,7 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     publisher.publish(&initial).context(ARRANGEMENT)?;
     sup.borrow_mut().published(&initial);
 
-    let mut states = node.subscribe::<ControllerState>(CONTROLLER_STATE, qos::stream())?;
+    let mut states = node.subscribe::<ControllerState>(CONTROLLER_STATE, qos::every_sample())?;
     let (s, p, log) = (sup.clone(), publisher.clone(), logger.clone());
     spawner.spawn_local(async move {
         while let Some(msg) = states.next().await {

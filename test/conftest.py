@@ -79,3 +79,29 @@ def spin_until(node, predicate, timeout_s: float, what):
             ex.spin_once(timeout_sec=0.05)
     finally:
         ex.remove_node(node)
+
+
+@pytest.fixture(scope="module")
+def store():
+    """rosbags' typestore: ROS 2 Jazzy types plus skin_msgs from its .msg files."""
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    ts = get_typestore(Stores.ROS2_JAZZY)
+    types = {}
+    for f in sorted((TOP / "skin_msgs" / "msg").glob("*.msg")):
+        types.update(get_types_from_msg(f.read_text(), f"skin_msgs/msg/{f.stem}"))
+    ts.register(types)
+    return ts
+
+
+def plain(v):
+    """A message as nested dicts and lists of Python numbers and strings, for exact comparison."""
+    import numpy as np
+
+    if hasattr(v, "__dataclass_fields__"):
+        return {k: plain(getattr(v, k)) for k in v.__dataclass_fields__ if k != "__msgtype__"}
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if isinstance(v, (list, tuple)):
+        return [plain(x) for x in v]
+    return v

@@ -11,22 +11,12 @@ import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.interfaces import MessageDefinitionFormat
 from rosbags.rosbag2 import StoragePlugin, Writer
-from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+from rosbags.typesys import get_types_from_msg
 
-from conftest import TOP, binary
+from conftest import binary, plain
 
 S = 1_000_000_000
 
-
-@pytest.fixture(scope="module")
-def store():
-    """ROS 2 Jazzy types plus skin_msgs from its .msg files."""
-    ts = get_typestore(Stores.ROS2_JAZZY)
-    types = {}
-    for f in sorted((TOP / "skin_msgs" / "msg").glob("*.msg")):
-        types.update(get_types_from_msg(f.read_text(), f"skin_msgs/msg/{f.stem}"))
-    ts.register(types)
-    return ts
 
 
 def expected(ts):
@@ -93,17 +83,6 @@ def expected(ts):
                 task(name="contact_reaction", priority=1, error_norm=2.5, torque_norm=30.0),
                 task(name="goal", priority=2, error_norm=0.2, torque_norm=12.0)])),
     ]
-
-
-def plain(v):
-    """A message as nested dicts and lists of Python numbers and strings, for exact comparison."""
-    if hasattr(v, "__dataclass_fields__"):
-        return {k: plain(getattr(v, k)) for k in v.__dataclass_fields__ if k != "__msgtype__"}
-    if isinstance(v, np.ndarray):
-        return v.tolist()
-    if isinstance(v, (list, tuple)):
-        return [plain(x) for x in v]
-    return v
 
 
 def test_rosbags_reads_every_field_of_a_rust_bag(tmp_path, store):

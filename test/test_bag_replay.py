@@ -19,12 +19,10 @@ compared: priority_supervisor's periodic republication of an unchanged arrangeme
 start-up arrangement's switch time (the node's start, wall clock)."""
 import signal
 
-import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
-from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
-from conftest import TOP, binary, spin_until
+from conftest import binary, plain, spin_until
 
 SCENE = "force_tracking_base_motion"
 SETUP = "config/controller/tomm_phases.yaml"
@@ -48,24 +46,6 @@ OUTPUTS = {
     "/supervisor/arrangement": "skin_msgs/msg/Arrangement",
 }
 LATCHED = ["/goal", "/hand_force_reference", "/supervisor/arrangement"]
-
-
-@pytest.fixture(scope="module")
-def store():
-    ts = get_typestore(Stores.ROS2_JAZZY)
-    for f in sorted((TOP / "skin_msgs" / "msg").glob("*.msg")):
-        ts.register(get_types_from_msg(f.read_text(), f"skin_msgs/msg/{f.stem}"))
-    return ts
-
-
-def plain(v):
-    if hasattr(v, "__dataclass_fields__"):
-        return {k: plain(getattr(v, k)) for k in v.__dataclass_fields__ if k != "__msgtype__"}
-    if isinstance(v, np.ndarray):
-        return v.tolist()
-    if isinstance(v, (list, tuple)):
-        return [plain(x) for x in v]
-    return v
 
 
 def read(bag):

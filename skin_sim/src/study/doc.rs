@@ -249,7 +249,11 @@ fn stability_section(s: &mut String, r: &StudyResults, images: &str) {
         .points
         .iter()
         .filter_map(|p| match &p.outcome {
-            Outcome::Skipped { reason } => Some(format!("- `{}` {}: skipped, {reason}", p.point.scenario, p.point.setting.label())),
+            Outcome::Skipped { reason } => {
+                // the reason names the scene file: keep the document free of this machine's paths
+                let reason = reason.replace(concat!(env!("CARGO_MANIFEST_DIR"), "/../"), "");
+                Some(format!("- `{}` {}: skipped, {reason}", p.point.scenario, p.point.setting.label()))
+            }
             Outcome::Failed { error } => Some(format!("- `{}` {}: **failed**, {error}", p.point.scenario, p.point.setting.label())),
             Outcome::Ran { .. } => None,
         })

@@ -105,3 +105,25 @@ def plain(v):
     if isinstance(v, (list, tuple)):
         return [plain(x) for x in v]
     return v
+
+
+def call_service(node, srv_type, name, request, timeout=30.0):
+    """Calls the service `name` from the rclpy `node` and returns the reply (waits for the service
+    and the reply with `spin_until`)."""
+    client = node.create_client(srv_type, name)
+    spin_until(node, client.service_is_ready, timeout, f"service {name}")
+    future = client.call_async(request)
+    spin_until(node, future.done, timeout, f"a reply from {name}")
+    return future.result()
+
+
+def set_parameter(node, target, name, value):
+    """Sets parameter `name` of the node `target` (e.g. `/task_controller`) through its standard
+    set_parameters service; returns the SetParametersResult."""
+    from rcl_interfaces.msg import Parameter
+    from rcl_interfaces.srv import SetParameters
+    from rclpy.parameter import Parameter as P
+
+    req = SetParameters.Request()
+    req.parameters = [Parameter(name=name, value=P(name, value=value).get_parameter_value())]
+    return call_service(node, SetParameters, f"{target}/set_parameters", req).results[0]

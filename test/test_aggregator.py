@@ -17,7 +17,7 @@ import pytest
 import yaml
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from conftest import TOP, binary, spin_until
+from conftest import TOP, binary, call_service, set_parameter, spin_until
 
 NODE = "skin_aggregator"
 LAYOUT = TOP / "config" / "skin" / "tomm.yaml"
@@ -157,20 +157,10 @@ class Peer:
         return self.patches_at(sec)[0]
 
     def call(self, srv_type, name, request):
-        client = self.node.create_client(srv_type, f"/{NODE}/{name}")
-        spin_until(self.node, client.service_is_ready, 30.0, f"service /{NODE}/{name}")
-        future = client.call_async(request)
-        spin_until(self.node, future.done, 30.0, f"a reply from /{NODE}/{name}")
-        return future.result()
+        return call_service(self.node, srv_type, f"/{NODE}/{name}", request)
 
     def set_param(self, name, value):
-        from rcl_interfaces.msg import Parameter
-        from rcl_interfaces.srv import SetParameters
-        from rclpy.parameter import Parameter as P
-
-        req = SetParameters.Request()
-        req.parameters = [Parameter(name=name, value=P(name, value=value).get_parameter_value())]
-        return self.call(SetParameters, "set_parameters", req).results[0]
+        return set_parameter(self.node, f"/{NODE}", name, value)
 
 
 def marker_by(markers, ns, mid):

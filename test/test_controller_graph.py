@@ -15,7 +15,7 @@ import pytest
 import yaml
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from conftest import TOP, binary, spin_until
+from conftest import TOP, binary, call_service, set_parameter, spin_until
 
 QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST,
@@ -80,20 +80,10 @@ class Peer:
         self.cells.publish(cells)
 
     def call(self, srv_type, name, request):
-        client = self.node.create_client(srv_type, name)
-        spin_until(self.node, client.service_is_ready, 30.0, f"service {name}")
-        future = client.call_async(request)
-        spin_until(self.node, future.done, 30.0, f"a reply from {name}")
-        return future.result()
+        return call_service(self.node, srv_type, name, request)
 
     def set_param(self, name, value):
-        from rcl_interfaces.msg import Parameter
-        from rcl_interfaces.srv import SetParameters
-        from rclpy.parameter import Parameter as P
-
-        req = SetParameters.Request()
-        req.parameters = [Parameter(name=name, value=P(name, value=value).get_parameter_value())]
-        return self.call(SetParameters, "/task_controller/set_parameters", req).results[0]
+        return set_parameter(self.node, "/task_controller", name, value)
 
 
 def test_controller_graph(spawn, rclpy_node):

@@ -28,7 +28,7 @@ use r2r::std_msgs::msg::{Float64, Float64MultiArray};
 
 use super::topics::*;
 use crate::qos;
-use crate::sim_bridge::{AppliedCommand, SimBridge};
+use crate::sim_bridge::{AppliedCommand, SimBridge, SimMessages};
 use crate::task_controller::ArmsParams;
 
 /// Node name.
@@ -102,6 +102,22 @@ pub struct SimHandle {
     last_force: Option<f64>,
 }
 
+/// The controller's sensor inputs of one period, joint states last: the controller's input set is
+/// complete with them.
+fn publish_inputs(pubs: &Pubs, m: &SimMessages) -> Result<()> {
+    if let Some(o) = &m.odom {
+        pubs.odom.publish(o).context(ODOM)?;
+    }
+    if let Some(s) = &m.scan {
+        pubs.scan.publish(s).context(SCAN)?;
+    }
+    if let Some(c) = &m.cells {
+        pubs.cells.publish(c).context(CELLS)?;
+    }
+    pubs.joints.publish(&m.joints).context(JOINT_STATES)?;
+    Ok(())
+}
+
 impl SimHandle {
     fn publish_state(&mut self) -> Result<()> {
         let m = self.bridge.messages();
@@ -115,35 +131,14 @@ impl SimHandle {
             }
             self.last_force = m.force_n;
         }
-        if let Some(o) = &m.odom {
-            self.pubs.odom.publish(o).context(ODOM)?;
-        }
-        if let Some(s) = &m.scan {
-            self.pubs.scan.publish(s).context(SCAN)?;
-        }
-        if let Some(c) = &m.cells {
-            self.pubs.cells.publish(c).context(CELLS)?;
-        }
-        // Last: the controller's input set is complete with it.
-        self.pubs.joints.publish(&m.joints).context(JOINT_STATES)?;
-        Ok(())
+        publish_inputs(&self.pubs, m)
     }
 
     fn republish(&mut self) -> Result<()> {
         // Same state, same stamps (the goal only if it is the period's; force unchanged).
-        let m = self.bridge.messages().clone();
+        let m = self.bridge.messages();
         self.pubs.clock.publish(&m.clock).context(CLOCK)?;
-        if let Some(o) = &m.odom {
-            self.pubs.odom.publish(o).context(ODOM)?;
-        }
-        if let Some(s) = &m.scan {
-            self.pubs.scan.publish(s).context(SCAN)?;
-        }
-        if let Some(c) = &m.cells {
-            self.pubs.cells.publish(c).context(CELLS)?;
-        }
-        self.pubs.joints.publish(&m.joints).context(JOINT_STATES)?;
-        Ok(())
+        publish_inputs(&self.pubs, m)
     }
 
     /// Takes the commands in the inbox into the bridge; in lockstep only when every topic has a

@@ -58,7 +58,7 @@ fn main() -> Result<()> {
     };
     let mut odom = Odometry::default();
     odom.pose.pose.orientation.w = 1.0;
-    let mut scan = LaserScan { header: r2r::std_msgs::msg::Header { frame_id: "laser".into(), ..Default::default() }, angle_min: -3.14, angle_max: 3.14, angle_increment: 0.0175, range_min: 0.05, range_max: 8.0, ranges: vec![8.5; 360], ..Default::default() };
+    let mut scan = LaserScan { header: r2r::std_msgs::msg::Header { frame_id: "laser".into(), ..Default::default() }, angle_min: -std::f32::consts::PI, angle_max: std::f32::consts::PI, angle_increment: std::f32::consts::TAU / 360.0, range_min: 0.05, range_max: 8.0, ranges: vec![8.5; 360], ..Default::default() };
     let mut cells = SkinCellArray {
         cells: config
             .layout

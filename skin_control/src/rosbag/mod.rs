@@ -4,21 +4,20 @@
 //!
 //! The file format is `skin_sim::bag`'s (profile `ros2`, one `ros2msg` schema per type with the
 //! complete definition of [`skin_sim::bag::full_definition`], one `cdr` channel per topic), read
-//! by rosbags, `ros2 bag` and Foxglove. Unlike `skin_sim::bag::BagWriter`, whose messages are
-//! typed Rust values, [`RawBagWriter`] takes bytes and a type name known only at run time, and
-//! stores each topic's offered QoS (`offered_qos_profiles`, as rosbag2 does) so that playback
-//! offers the same durability (a latched `/goal` stays latched).
+//! by rosbags, `ros2 bag` and Foxglove, and written by `skin_sim::bag::BagWriter` itself:
+//! [`RawBagWriter`] only adds the definitions of types skin_sim does not embed (from the ament
+//! index) and stores each topic's offered QoS (`offered_qos_profiles`, as rosbag2 does) so that
+//! playback offers the same durability (a latched `/goal` stays latched).
 //!
 //! - [`record`]: `skin_bag record`;
 //! - [`play`]: `skin_bag play`;
 //! - this module: what neither needs ROS for (topic specs, the writer and reader, header stamps,
 //!   QoS metadata, the step schedule), unit tested.
-use std::collections::{BTreeMap, HashMap};
-use std::fs::File;
-use std::io::BufWriter;
-use std::path::{Path, PathBuf};
+use std::collections::BTreeMap;
+use std::path::Path;
 
 use anyhow::{bail, Context as _, Result};
+use skin_sim::bag::BagWriter;
 use r2r::qos::{DurabilityPolicy, HistoryPolicy, ReliabilityPolicy};
 use r2r::QosProfile;
 
@@ -210,88 +209,36 @@ fn ament_definition(type_name: &str, prefixes: &str, seen: &mut std::collections
     Ok(out)
 }
 
-/// A channel registered by [`RawBagWriter`].
-struct Channel {
-    id: u16,
-    type_name: String,
-    sequence: u32,
-    count: u64,
-}
-
-/// Writes serialized messages of types known at run time into a rosbag2 MCAP file (the format
-/// of `skin_sim::bag`). Call [`RawBagWriter::finish`]: it writes the summary readers seek by.
-pub struct RawBagWriter {
-    path: PathBuf,
-    mcap: mcap::Writer<BufWriter<File>>,
-    schemas: HashMap<String, u16>,
-    channels: BTreeMap<String, Channel>,
-}
+/// [`skin_sim::bag::BagWriter`] for serialized messages of types known only at run time: the
+/// definitions come from skin_sim's embedded ones or the ament index ([`full_definition`]).
+pub struct RawBagWriter(BagWriter);
 
 impl RawBagWriter {
     /// Creates (or truncates) the bag file at `path`.
     pub fn create(path: &Path) -> Result<Self> {
-        let file = File::create(path).with_context(|| format!("{}: cannot create the bag", path.display()))?;
-        let mcap = mcap::WriteOptions::new()
-            .profile("ros2")
-            .library(concat!("skin_bag ", env!("CARGO_PKG_VERSION")))
-            .compression(None)
-            .create(BufWriter::new(file))
-            .with_context(|| format!("{}: MCAP header", path.display()))?;
-        Ok(Self { path: path.to_path_buf(), mcap, schemas: HashMap::new(), channels: BTreeMap::new() })
+        Ok(Self(BagWriter::create(path)?))
     }
 
     /// Registers `topic` with its type and the offered QoS text (before its first message).
     pub fn add_topic(&mut self, topic: &str, type_name: &str, offered_qos: &str) -> Result<()> {
-        let schema = match self.schemas.get(type_name) {
-            Some(&id) => id,
-            None => {
-                let text = full_definition(type_name)
-                    .map_err(|e| anyhow::anyhow!("{}: topic {topic}: no message definition for type {type_name}: {e}", self.path.display()))?;
-                let id = self
-                    .mcap
-                    .add_schema(type_name, "ros2msg", text.as_bytes())
-                    .with_context(|| format!("{}: schema of {type_name}", self.path.display()))?;
-                self.schemas.insert(type_name.to_string(), id);
-                id
-            }
-        };
-        let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), offered_qos.to_string())]);
-        let id = self
-            .mcap
-            .add_channel(schema, topic, "cdr", &metadata)
-            .with_context(|| format!("{}: channel of {topic}", self.path.display()))?;
-        self.channels.insert(topic.to_string(), Channel { id, type_name: type_name.to_string(), sequence: 0, count: 0 });
-        Ok(())
+        let definition = full_definition(type_name)
+            .map_err(|e| anyhow::anyhow!("topic {topic}: no message definition for type {type_name}: {e}"))?;
+        Ok(self.0.add_topic(topic, type_name, &definition, offered_qos)?)
     }
 
     /// Writes one serialized message (CDR with its encapsulation header) of a registered topic.
     pub fn write(&mut self, topic: &str, t_ns: u64, data: &[u8]) -> Result<()> {
-        let Some(channel) = self.channels.get_mut(topic) else {
-            bail!("{}: topic {topic} was not registered", self.path.display());
-        };
-        channel.sequence = channel.sequence.wrapping_add(1);
-        channel.count += 1;
-        let header = mcap::records::MessageHeader { channel_id: channel.id, sequence: channel.sequence, log_time: t_ns, publish_time: t_ns };
-        self.mcap
-            .write_to_known_channel(&header, data)
-            .with_context(|| format!("{}: topic {topic} ({})", self.path.display(), channel.type_name))
+        Ok(self.0.write_raw(topic, t_ns, data)?)
     }
 
     /// Messages written per topic.
     pub fn counts(&self) -> impl Iterator<Item = (&str, u64)> {
-        self.channels.iter().map(|(t, c)| (t.as_str(), c.count))
+        self.0.counts()
     }
 
     /// Writes the summary and closes the file.
-    pub fn finish(mut self) -> Result<()> {
-        let path = self.path.display().to_string();
-        self.mcap.finish().with_context(|| format!("{path}: MCAP summary"))?;
-        self.mcap
-            .into_inner()
-            .into_inner()
-            .map_err(|e| e.into_error())
-            .with_context(|| format!("{path}: flushing"))?;
-        Ok(())
+    pub fn finish(self) -> Result<()> {
+        Ok(self.0.finish()?)
     }
 }
 

@@ -70,6 +70,14 @@ pub enum BagError {
         /// The type without a definition.
         type_name: String,
     },
+    /// A raw message for a topic that was not registered with its type first.
+    #[error("{}: topic {topic} was not registered", path.display())]
+    Unregistered {
+        /// The bag file.
+        path: PathBuf,
+        /// The topic.
+        topic: String,
+    },
     /// A channel whose message encoding is not CDR.
     #[error("{}: topic {topic}: message encoding {encoding:?}, expected \"cdr\"", path.display())]
     Encoding {

@@ -10,18 +10,20 @@ use super::{cdr, defs, BagError, RosMessage};
 /// A channel registered for a topic.
 struct Channel {
     id: u16,
-    type_name: &'static str,
+    type_name: String,
     sequence: u32,
+    count: u64,
 }
 
-/// Writes a rosbag2 MCAP file. Schemas are registered once per type and channels once per
-/// topic, on first use. Call [`BagWriter::finish`]: it writes the summary and index that readers
-/// seek by.
+/// Writes a rosbag2 MCAP file: typed messages ([`BagWriter::write`]) or serialized ones of types
+/// known only at run time ([`BagWriter::add_topic`] + [`BagWriter::write_raw`], what a recorder
+/// needs). Schemas are registered once per type, channels once per topic. Call
+/// [`BagWriter::finish`]: it writes the summary and index that readers seek by.
 pub struct BagWriter {
     path: PathBuf,
     mcap: mcap::Writer<BufWriter<File>>,
-    schemas: HashMap<&'static str, u16>,
-    channels: HashMap<String, Channel>,
+    schemas: HashMap<String, u16>,
+    channels: BTreeMap<String, Channel>,
 }
 
 impl BagWriter {
@@ -46,11 +48,13 @@ impl BagWriter {
             path,
             mcap,
             schemas: HashMap::new(),
-            channels: HashMap::new(),
+            channels: BTreeMap::new(),
         })
     }
 
     /// Write `msg` on `topic`, received and published at `t_ns` (ns; sim time or wall clock).
+    /// The topic is registered on first use with its type's definition and no QoS (the player's
+    /// defaults).
     pub fn write<M: RosMessage>(
         &mut self,
         topic: &str,
@@ -62,8 +66,72 @@ impl BagWriter {
             topic: topic.to_string(),
             message,
         })?;
-        let channel = self.channel(topic, M::TYPE_NAME)?;
+        match self.channels.get(topic) {
+            None => {
+                let definition = defs::full_definition(M::TYPE_NAME).map_err(|missing| BagError::UnknownType {
+                    path: self.path.clone(),
+                    topic: topic.to_string(),
+                    type_name: missing,
+                })?;
+                self.add_topic(topic, M::TYPE_NAME, &definition, "")?;
+            }
+            Some(c) if c.type_name != M::TYPE_NAME => {
+                return Err(BagError::TopicType {
+                    path: self.path.clone(),
+                    topic: topic.to_string(),
+                    registered: c.type_name.clone(),
+                    requested: M::TYPE_NAME.to_string(),
+                })
+            }
+            Some(_) => {}
+        }
+        self.write_raw(topic, t_ns, &data)
+    }
+
+    /// Registers `topic` (before its first message) with its type, the type's full definition
+    /// as rosbag2 stores it, and the publishers' offered QoS (rosbag2's YAML text; empty: the
+    /// player's defaults).
+    pub fn add_topic(&mut self, topic: &str, type_name: &str, definition: &str, offered_qos: &str) -> Result<(), BagError> {
+        let path = self.path.clone();
+        let mcap_error = move |source| BagError::Mcap { path: path.clone(), source };
+        let schema = match self.schemas.get(type_name) {
+            Some(&id) => id,
+            None => {
+                let id = self
+                    .mcap
+                    .add_schema(type_name, "ros2msg", definition.as_bytes())
+                    .map_err(&mcap_error)?;
+                self.schemas.insert(type_name.to_string(), id);
+                id
+            }
+        };
+        let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), offered_qos.to_string())]);
+        let id = self
+            .mcap
+            .add_channel(schema, topic, "cdr", &metadata)
+            .map_err(&mcap_error)?;
+        self.channels.insert(
+            topic.to_string(),
+            Channel {
+                id,
+                type_name: type_name.to_string(),
+                sequence: 0,
+                count: 0,
+            },
+        );
+        Ok(())
+    }
+
+    /// Writes one serialized message (CDR with its encapsulation header) of a registered topic.
+    pub fn write_raw(&mut self, topic: &str, t_ns: u64, data: &[u8]) -> Result<(), BagError> {
+        let Some(channel) = self.channels.get_mut(topic) else {
+            return Err(BagError::Unregistered {
+                path: self.path.clone(),
+                topic: topic.to_string(),
+            });
+        };
         channel.sequence = channel.sequence.wrapping_add(1);
+        channel.count += 1;
         let header = mcap::records::MessageHeader {
             channel_id: channel.id,
             sequence: channel.sequence,
@@ -71,11 +139,16 @@ impl BagWriter {
             publish_time: t_ns,
         };
         self.mcap
-            .write_to_known_channel(&header, &data)
+            .write_to_known_channel(&header, data)
             .map_err(|source| BagError::Mcap {
                 path: self.path.clone(),
                 source,
             })
+    }
+
+    /// Messages written per topic, in topic order.
+    pub fn counts(&self) -> impl Iterator<Item = (&str, u64)> {
+        self.channels.iter().map(|(t, c)| (t.as_str(), c.count))
     }
 
     /// Write the summary and close the file.
@@ -93,59 +166,5 @@ impl BagWriter {
                 source: e.into_error(),
             })?;
         Ok(())
-    }
-
-    /// The channel of `topic`, registered (with its type's schema) on first use.
-    fn channel(&mut self, topic: &str, type_name: &'static str) -> Result<&mut Channel, BagError> {
-        if !self.channels.contains_key(topic) {
-            let schema = self.schema(topic, type_name)?;
-            // rosbag2 records the publishers' QoS here; empty = the player's defaults.
-            let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), String::new())]);
-            let id = self
-                .mcap
-                .add_channel(schema, topic, "cdr", &metadata)
-                .map_err(|source| BagError::Mcap {
-                    path: self.path.clone(),
-                    source,
-                })?;
-            self.channels.insert(
-                topic.to_string(),
-                Channel {
-                    id,
-                    type_name,
-                    sequence: 0,
-                },
-            );
-        }
-        let channel = self.channels.get_mut(topic).expect("registered above");
-        if channel.type_name != type_name {
-            return Err(BagError::TopicType {
-                path: self.path.clone(),
-                topic: topic.to_string(),
-                registered: channel.type_name.to_string(),
-                requested: type_name.to_string(),
-            });
-        }
-        Ok(channel)
-    }
-
-    fn schema(&mut self, topic: &str, type_name: &'static str) -> Result<u16, BagError> {
-        if let Some(&id) = self.schemas.get(type_name) {
-            return Ok(id);
-        }
-        let text = defs::full_definition(type_name).map_err(|missing| BagError::UnknownType {
-            path: self.path.clone(),
-            topic: topic.to_string(),
-            type_name: missing,
-        })?;
-        let id = self
-            .mcap
-            .add_schema(type_name, "ros2msg", text.as_bytes())
-            .map_err(|source| BagError::Mcap {
-                path: self.path.clone(),
-                source,
-            })?;
-        self.schemas.insert(type_name, id);
-        Ok(id)
     }
 }

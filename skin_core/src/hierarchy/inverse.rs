@@ -127,7 +127,41 @@ pub(crate) fn cholesky(m: &[f64], l: &mut [f64], n: usize) -> Result<(), Hierarc
 /// `M⁻¹ = L⁻ᵀ L⁻¹` from the Cholesky factor `l`; `linv` is scratch (n × n), `minv` the result
 /// (full symmetric matrix).
 pub(crate) fn spd_inverse_from_cholesky(l: &[f64], linv: &mut [f64], minv: &mut [f64], n: usize) {
-    // column j of L⁻¹: forward substitution L x = e_j, column-oriented
+    lower_inverse(l, linv, n);
+    // (L⁻ᵀ L⁻¹)_ij = Σ_{k ≥ max(i,j)} L⁻¹_ki L⁻¹_kj: a dot product of two column tails
+    for j in 0..n {
+        for i in 0..=j {
+            let s = super::dense::dot(&linv[i * n + j..(i + 1) * n], &linv[j * n + j..(j + 1) * n]);
+            minv[j * n + i] = s;
+            minv[i * n + j] = s;
+        }
+    }
+}
+
+/// [`spd_inverse_from_cholesky`] into the padded `minv` (ld × n, `dense::padded_len`): the same
+/// sums `Σ_k L⁻¹_ki L⁻¹_kj` in the same order, as rank-one updates with the rows `r_k` of `L⁻¹`
+/// (nonzero up to column k) down padded columns instead of n² short dot products. `linv` (n × n)
+/// and `rows` (ld × n, the rows as padded columns) are scratch.
+pub(crate) fn spd_inverse_padded(l: &[f64], linv: &mut [f64], rows: &mut [f64], minv: &mut [f64], n: usize, ld: usize) {
+    lower_inverse(l, linv, n);
+    for (k, rk) in rows[..ld * n].chunks_exact_mut(ld).enumerate() {
+        for (j, x) in rk.iter_mut().enumerate() {
+            *x = if j < n { linv[j * n + k] } else { 0.0 };
+        }
+    }
+    // −M⁻¹ = −Σ_k r_k r_kᵀ (the columns j ≤ k that r_k reaches), then negated: exact
+    minv[..ld * n].fill(0.0);
+    for (k, rk) in rows[..ld * n].chunks_exact(ld).enumerate() {
+        super::dense::sub_outer_padded(&mut minv[..ld * (k + 1)], rk, &rk[..=k], ld, k + 1);
+    }
+    for x in &mut minv[..ld * n] {
+        *x = -*x;
+    }
+}
+
+/// `L⁻¹` of the lower triangular `l` into `linv` (n × n): column j by forward substitution
+/// `L x = e_j`, column-oriented.
+fn lower_inverse(l: &[f64], linv: &mut [f64], n: usize) {
     linv[..n * n].fill(0.0);
     for j in 0..n {
         let x = &mut linv[j * n..(j + 1) * n];
@@ -141,14 +175,6 @@ pub(crate) fn spd_inverse_from_cholesky(l: &[f64], linv: &mut [f64], minv: &mut 
                     *xi -= xk * li;
                 }
             }
-        }
-    }
-    // (L⁻ᵀ L⁻¹)_ij = Σ_{k ≥ max(i,j)} L⁻¹_ki L⁻¹_kj: a dot product of two column tails
-    for j in 0..n {
-        for i in 0..=j {
-            let s = super::dense::dot(&linv[i * n + j..(i + 1) * n], &linv[j * n + j..(j + 1) * n]);
-            minv[j * n + i] = s;
-            minv[i * n + j] = s;
         }
     }
 }
@@ -431,6 +457,22 @@ mod tests {
             let mi = DMatrix::from_column_slice(n, n, &mi);
             let err = (&m * &mi - DMatrix::identity(n, n)).norm();
             assert!(err < 1e-10, "n = {n}: |M M⁻¹ − I| = {err}");
+        }
+    }
+
+    #[test]
+    fn padded_inverse_is_the_plain_one() {
+        for n in [1, 7, 15, 17] {
+            let m = random_spd(n, 50 + n as u64);
+            let ld = crate::hierarchy::dense::padded_len(n);
+            let (mut l, mut li, mut mi) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
+            let (mut rows, mut mp, mut back) = (vec![0.0; ld * n], vec![1.0; ld * n], vec![0.0; n * n]);
+            cholesky(m.as_slice(), &mut l, n).unwrap();
+            spd_inverse_from_cholesky(&l, &mut li, &mut mi, n);
+            spd_inverse_padded(&l, &mut li, &mut rows, &mut mp, n, ld);
+            crate::hierarchy::dense::unpad(&mp, &mut back, n, ld, n);
+            assert_eq!(back, mi, "n = {n}");
+            assert!(mp.chunks_exact(ld).all(|c| c[n..].iter().all(|&x| x == 0.0)), "padding stays zero");
         }
     }
 

@@ -5,8 +5,11 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::model::{bias_forces, crba, ModelData, RobotModel};
 
-use super::dense::{add_mul_vec, axpy, dot, mul, mul_tn, mul_tr_vec, mul_vec, norm, sub_mul_nt};
-use super::inverse::{cholesky, damped_inverse, spd_inverse_from_cholesky, symmetric_eigen, InverseParams};
+use super::dense::{
+    add_mul_vec, axpy, dot, mul, mul_padded, mul_tn, mul_tr_vec, mul_vec, mul_vec_padded, norm, pad, padded_len, set_identity_padded,
+    sub_mul_nt, sub_outer_padded, unpad,
+};
+use super::inverse::{cholesky, damped_inverse, spd_inverse_padded, symmetric_eigen, InverseParams};
 use super::{HierarchyError, ReferenceKind, TaskLevel};
 
 /// What one level did in the last solve.
@@ -61,9 +64,14 @@ pub struct HierarchySolver {
     chol: Vec<f64>,
     linv: Vec<f64>,
     minv: DMatrix<f64>,
-    /// N_{k−1} during the pass, N_L after it.
+    /// N_L of the last solve (copied from `nproj_pad`).
     nproj: DMatrix<f64>,
-    /// n × max_rows: J̄ᵀ, M⁻¹J̄ᵀ, N J̄ᵀ, M⁻¹J̄ᵀΛ̄.
+    /// `M⁻¹` and N_{k−1} (during the pass) with padded columns (`dense::padded_len`), so that
+    /// the products with them run without remainder loops.
+    minv_pad: Vec<f64>,
+    nproj_pad: Vec<f64>,
+    /// n × max_rows: J̄ᵀ, M⁻¹J̄ᵀ, N J̄ᵀ (`z`: padded, ld × max(max_rows, n), also the scratch of
+    /// the other padded products), M⁻¹J̄ᵀΛ̄.
     jbt: Vec<f64>,
     y: Vec<f64>,
     z: Vec<f64>,
@@ -88,13 +96,15 @@ pub struct HierarchySolver {
     bias_model: DVector<f64>,
     /// Joints held still ([`HierarchySolver::set_locked_joints`]).
     locked: Vec<bool>,
+    /// Activated levels, row by row: the row's `j̄ᵀ`, `M⁻¹ j̄ᵀ`, `N j̄ᵀ` (padded).
+    row_pad: [Vec<f64>; 3],
 }
 
 impl HierarchySolver {
     /// Workspace for `nv` joints, at most `max_levels` levels of at most `max_rows` rows each.
     pub fn new(nv: usize, max_levels: usize, max_rows: usize, params: InverseParams) -> Result<Self, HierarchyError> {
         params.validate()?;
-        let (n, m) = (nv, max_rows);
+        let (n, m, ld) = (nv, max_rows, padded_len(nv));
         Ok(Self {
             nv,
             max_levels,
@@ -106,7 +116,7 @@ impl HierarchySolver {
             nproj: DMatrix::identity(n, n),
             jbt: vec![0.0; n * m],
             y: vec![0.0; n * m],
-            z: vec![0.0; n * m],
+            z: vec![0.0; ld * m.max(n)],
             wt: vec![0.0; n * m],
             a: vec![0.0; m * m],
             v: vec![0.0; m * m],
@@ -117,12 +127,15 @@ impl HierarchySolver {
             tau_sum: vec![0.0; n],
             tau_bar: vec![0.0; n],
             u_sum: vec![0.0; n],
-            posture_proj: vec![0.0; n],
+            posture_proj: vec![0.0; ld],
             qdd: DVector::zeros(n),
             diagnostics: Vec::with_capacity(max_levels),
             m_model: DMatrix::zeros(n, n),
             bias_model: DVector::zeros(n),
             locked: vec![false; n],
+            minv_pad: vec![0.0; ld * n],
+            nproj_pad: vec![0.0; ld * n],
+            row_pad: std::array::from_fn(|_| vec![0.0; ld]),
         })
     }
 
@@ -189,13 +202,14 @@ impl HierarchySolver {
         I: IntoIterator<Item = &'a TaskLevel>,
         I::IntoIter: Clone,
     {
-        let n = self.nv;
+        let (n, ld) = (self.nv, padded_len(self.nv));
         self.check_inputs(mass_matrix, posture, bias, tau_out)?;
         let levels = levels.into_iter();
 
         cholesky(mass_matrix.as_slice(), &mut self.chol, n)?;
-        spd_inverse_from_cholesky(&self.chol, &mut self.linv, self.minv.as_mut_slice(), n);
-        self.nproj.fill_with_identity();
+        spd_inverse_padded(&self.chol, &mut self.linv, &mut self.z, &mut self.minv_pad, n, ld);
+        unpad(&self.minv_pad, self.minv.as_mut_slice(), n, ld, n);
+        set_identity_padded(&mut self.nproj_pad, n, ld);
         self.tau_sum.fill(0.0);
         self.u_sum.fill(0.0);
         self.diagnostics.clear();
@@ -211,12 +225,12 @@ impl HierarchySolver {
             }
             let (nm, mm) = (n * m, m * m);
             let jt = level.jt_slice();
-            let minv = self.minv.as_slice();
             // J̄_kᵀ = N_{k−1} J_kᵀ (eq. 22)
             if first {
                 self.jbt[..nm].copy_from_slice(jt);
             } else {
-                mul(self.nproj.as_slice(), jt, &mut self.jbt[..nm], n, n, m);
+                mul_padded(&self.nproj_pad, jt, &mut self.z, ld, n, m);
+                unpad(&self.z, &mut self.jbt, n, ld, m);
             }
             if level.is_activated() {
                 // skin rows with activations: weighted, row by row (any m)
@@ -231,7 +245,8 @@ impl HierarchySolver {
                 continue;
             }
             // Y = M⁻¹ J̄ᵀ, A = J̄ M⁻¹ J̄ᵀ (symmetrized against round-off), Λ̄ (eq. 23)
-            mul(minv, &self.jbt[..nm], &mut self.y[..nm], n, n, m);
+            mul_padded(&self.minv_pad, &self.jbt[..nm], &mut self.z, ld, n, m);
+            unpad(&self.z, &mut self.y, n, ld, m);
             mul_tn(&self.jbt[..nm], &self.y[..nm], &mut self.a[..mm], n, m, m);
             for c in 0..m {
                 for r in 0..c {
@@ -271,11 +286,11 @@ impl HierarchySolver {
             if info.rank > 0 {
                 mul(&self.y[..nm], &self.lam[..mm], &mut self.wt[..nm], n, m, m);
                 if first {
-                    self.z[..nm].copy_from_slice(&self.jbt[..nm]);
+                    pad(&self.jbt, &mut self.z, n, ld, m);
                 } else {
-                    mul(self.nproj.as_slice(), &self.jbt[..nm], &mut self.z[..nm], n, n, m);
+                    mul_padded(&self.nproj_pad, &self.jbt[..nm], &mut self.z, ld, n, m);
                 }
-                sub_mul_nt(self.nproj.as_mut_slice(), &self.z[..nm], &self.wt[..nm], n, m, n);
+                sub_mul_nt(&mut self.nproj_pad, &self.z, &self.wt[..nm], ld, m, n);
                 first = false;
             }
             self.diagnostics.push(diag);
@@ -283,8 +298,9 @@ impl HierarchySolver {
 
         // N_L τ_c* (eq. 19) and the predicted acceleration
         let nlevels = self.diagnostics.len();
+        unpad(&self.nproj_pad, self.nproj.as_mut_slice(), n, ld, n);
         if let Some(tc) = posture {
-            mul_vec(self.nproj.as_slice(), tc, &mut self.posture_proj, n, n);
+            mul_vec_padded(&self.nproj_pad, tc, &mut self.posture_proj, ld, n);
             axpy(1.0, &self.posture_proj, &mut self.tau_sum);
             add_mul_vec(self.minv.as_slice(), &self.posture_proj, &mut self.u_sum, n, n);
         }
@@ -392,12 +408,13 @@ impl HierarchySolver {
                     *x *= s;
                 }
             }
+            let ld = padded_len(n);
             if *first {
-                self.z[..nn].copy_from_slice(&self.w[..nn]);
+                pad(&self.w, &mut self.z, n, ld, n);
             } else {
-                mul(self.nproj.as_slice(), &self.w[..nn], &mut self.z[..nn], n, n, n);
+                mul_padded(&self.nproj_pad, &self.w[..nn], &mut self.z, ld, n, n);
             }
-            sub_mul_nt(self.nproj.as_mut_slice(), &self.z[..nn], &self.lam[..nn], n, n, n);
+            sub_mul_nt(&mut self.nproj_pad, &self.z, &self.lam[..nn], ld, n, n);
             *first = false;
         }
         Ok(())
@@ -426,18 +443,25 @@ impl HierarchySolver {
         if !self.tau_sum.iter().all(|t| t.is_finite()) {
             return Err(HierarchyError::Overflow { level: k });
         }
-        let jt = level.jt_slice();
-        for (i, &a) in level.activation().iter().enumerate() {
-            let row = &jt[i * n..(i + 1) * n];
-            // j̄ᵀ = N j_iᵀ (y), M⁻¹ j̄ᵀ (z), N j̄ᵀ (wt)
-            let (jb, mj, nj) = (&mut self.y[..n], &mut self.z[..n], &mut self.wt[..n]);
+        self.project_activated_rows(level, diag, first);
+        Ok(())
+    }
+
+    /// The row-by-row projector update of [`Self::activated_level`] on the padded `N` and `M⁻¹`:
+    /// `4 n²` per row, the level's main cost (the torque costs `n m`).
+    fn project_activated_rows(&mut self, level: &TaskLevel, diag: &mut LevelDiagnostics, first: &mut bool) {
+        let (n, ld) = (self.nv, padded_len(self.nv));
+        let [jb, mj, nj] = &mut self.row_pad;
+        jb.fill(0.0);
+        for (row, &a) in level.jt_slice().chunks_exact(n).zip(level.activation()) {
+            // j̄ᵀ = N j_iᵀ (jb), M⁻¹ j̄ᵀ (mj), N j̄ᵀ (nj)
             if *first {
-                jb.copy_from_slice(row);
+                jb[..n].copy_from_slice(row);
             } else {
-                mul_vec(self.nproj.as_slice(), row, jb, n, n);
+                mul_vec_padded(&self.nproj_pad, row, jb, ld, n);
             }
-            mul_vec(self.minv.as_slice(), jb, mj, n, n);
-            let e = dot(jb, mj);
+            mul_vec_padded(&self.minv_pad, jb, mj, ld, n);
+            let e = dot(&jb[..n], &mj[..n]);
             let f = self.params.filter(e, self.params.threshold(e));
             if f <= 0.0 {
                 continue;
@@ -451,15 +475,14 @@ impl HierarchySolver {
             if *first {
                 nj.copy_from_slice(jb);
             } else {
-                mul_vec(self.nproj.as_slice(), jb, nj, n, n);
+                mul_vec_padded(&self.nproj_pad, jb, nj, ld, n);
             }
-            for x in mj.iter_mut() {
+            for x in mj[..n].iter_mut() {
                 *x *= a * f;
             }
-            sub_mul_nt(self.nproj.as_mut_slice(), nj, mj, n, 1, n);
+            sub_outer_padded(&mut self.nproj_pad, nj, mj, ld, n);
             *first = false;
         }
-        Ok(())
     }
 
     /// Marks joints as locked for [`HierarchySolver::solve_model`] (length `nv`): their rows and
@@ -559,22 +582,31 @@ impl HierarchySolver {
             });
         }
         let bad = |what, index: usize, value: f64| HierarchyError::NonFiniteLevel { level: k, name: level.name().to_string(), what, index, value };
-        if let Some((i, &v)) = level.jt_slice().iter().enumerate().find(|(_, x)| !x.is_finite()) {
+        if let Some(i) = first_non_finite(level.jt_slice()) {
             // storage is Jᵀ column-major, so i = row · nv + column of J
-            return Err(bad("jacobian", i, v));
+            return Err(bad("jacobian", i, level.jt_slice()[i]));
         }
         let (target_name, drift) = match level.kind() {
             ReferenceKind::Acceleration => ("xdd_star", true),
             ReferenceKind::Force => ("force", false),
         };
-        if let Some((i, &v)) = level.target().iter().enumerate().find(|(_, x)| !x.is_finite()) {
-            return Err(bad(target_name, i, v));
+        if let Some(i) = first_non_finite(level.target()) {
+            return Err(bad(target_name, i, level.target()[i]));
         }
         if drift {
-            if let Some((i, &v)) = level.jdot_qdot().iter().enumerate().find(|(_, x)| !x.is_finite()) {
-                return Err(bad("jdot_qdot", i, v));
+            if let Some(i) = first_non_finite(level.jdot_qdot()) {
+                return Err(bad("jdot_qdot", i, level.jdot_qdot()[i]));
             }
         }
         Ok(())
     }
+}
+
+/// Index of the first NaN or infinite entry of `x`. The usual all-finite case is one pass without
+/// a branch per entry (the levels' Jacobians are checked every solve).
+fn first_non_finite(x: &[f64]) -> Option<usize> {
+    if x.iter().fold(true, |ok, v| ok & v.is_finite()) {
+        return None;
+    }
+    x.iter().position(|v| !v.is_finite())
 }

@@ -165,8 +165,8 @@ impl TaskLevel {
         }
         let r0 = self.begin_rows(1, &reference)?;
         let col = &mut self.jt[r0 * self.nv..(r0 + 1) * self.nv];
-        for (c, x) in col.iter_mut().enumerate() {
-            *x = direction.iter().enumerate().map(|(r, d)| d * jacobian[(r, c)]).sum();
+        for (x, jc) in col.iter_mut().zip(jacobian.column_iter()) {
+            *x = direction.iter().zip(jc.iter()).map(|(d, j)| d * j).sum();
         }
         self.store_reference(r0, 1, &reference);
         Ok(())

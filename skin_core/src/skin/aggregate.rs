@@ -137,6 +137,15 @@ pub fn aggregate_patches(
     Ok(())
 }
 
+/// No raw value above 0 (so every sanitized signal is 0, NaN included): the cell adds nothing to
+/// the wrench or the maxima, whatever `w` and the threshold are. Most cells of a skin are silent,
+/// and this test is cheaper than the sanitizing.
+#[inline]
+fn is_silent(r: &CellReading) -> bool {
+    // `|`, not `||`: one branch for the cell, not one per value
+    !((r.force[0] > 0.0) | (r.force[1] > 0.0) | (r.force[2] > 0.0) | (r.proximity > 0.0))
+}
+
 #[inline]
 fn aggregate_range(
     layout: &ResolvedLayout,
@@ -151,6 +160,9 @@ fn aggregate_range(
     let mut w = PatchWrench::default();
     let mut sum_t = Vector3::zeros();
     for (g, r) in geometry.iter().zip(readings) {
+        if is_silent(r) {
+            continue;
+        }
         let f = r.force_signal(fusion.force_reduction);
         let p = r.proximity_signal();
         w.max_force_signal = w.max_force_signal.max(f);

@@ -77,10 +77,12 @@ impl BaseAvoidance {
 
     /// The sector of `p`: sector `s` spans the angles `atan2(y, x) + π ∈ [2π s/n, 2π (s+1)/n)`.
     /// Compared in the pseudo-angle of [`diamond_angle`] (monotone in the angle, no `atan2`)
-    /// against the sector bounds precomputed in it.
+    /// against the sector bounds precomputed in it. The bounds increase, so the sector is the
+    /// number of bounds at or below the angle, counted without a branch per bound (the sector
+    /// of consecutive scan points varies, which a loop's exit would mispredict).
     fn sector(&self, p: &Vector2<f64>) -> usize {
         let a = diamond_angle(-p.y, -p.x);
-        self.bounds.iter().take_while(|&&b| a >= b).count()
+        self.bounds.iter().map(|&b| usize::from(a >= b)).sum()
     }
 
     /// Closest footprint point to `p` (base frame) and its distance (0 inside).

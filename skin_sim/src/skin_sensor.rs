@@ -5,11 +5,14 @@
 //! - Proximity: `mj_ray` from the cell's world position along its outward normal, testing only
 //!   objects and persons ([`SENSED_GROUPS`]: the robot never sees itself); the hit distance goes
 //!   through `p(d)` (0 from the sensor range on). A cell in contact reads 1.
-//! - Force: each contact that involves a robot geom gives its normal force (`mj_contactForce`) to
-//!   the cells of the touched body within `contact_radius_m` of the contact point, split with
-//!   weights falling linearly with distance and proportional to how squarely the cell faces the
-//!   force; a cell keeps the part of its share pressing along its inward normal, and that force
-//!   in newtons goes through `f(F)` on all three sensors.
+//! - Force: the contacts of one robot geom with one other geom (MuJoCo reports a flat contact
+//!   between boxes as the corners of the touching area) give their summed normal force
+//!   (`mj_contactForce`) to the cells of the touched body within `contact_radius_m` of the box
+//!   spanned by their points, split with weights falling linearly with that distance and
+//!   proportional to how squarely the cell faces the force; a cell keeps the part of its share
+//!   pressing along its inward normal, and that force in newtons goes through `f(F)` on all
+//!   three sensors. (Per contact point instead, a flat palm's force went to the 2-4 cells nearest
+//!   the palm's corners and saturated them: 54 N read as one saturated cell.)
 //! - Optional zero-mean Gaussian noise on every signal (seeded), then clamped to [0, 1].
 
 use std::ops::Range;
@@ -35,6 +38,20 @@ struct SimCell {
     active: bool,
 }
 
+/// The contacts of one robot geom with one other geom in a sample.
+#[derive(Debug, Clone, Copy)]
+struct ContactPatch {
+    /// Robot geom, other geom.
+    geoms: [usize; 2],
+    /// MuJoCo body of the robot geom.
+    body: usize,
+    /// Summed force on the robot geom (world) \[N\].
+    force: Vector3<f64>,
+    /// Box spanned by the contact points (world axes).
+    min: Point3<f64>,
+    max: Point3<f64>,
+}
+
 /// The skin of a [`crate::world::World`]; readings are indexed like the scene layout's cells.
 #[derive(Debug, Clone)]
 pub struct SkinSensor {
@@ -50,6 +67,8 @@ pub struct SkinSensor {
     noise: Noise,
     /// Scratch: normal force per cell \[N\].
     force_n: Vec<f64>,
+    /// Scratch: this sample's contacts, one per pair of touching geoms.
+    patches: Vec<ContactPatch>,
     readings: Vec<CellReading>,
 }
 
@@ -97,6 +116,7 @@ impl SkinSensor {
             force_noise_std: spec.force_noise_std,
             noise: Noise::new(scene.spec.seed, NOISE_STREAM),
             force_n: vec![0.0; n],
+            patches: Vec::new(),
             readings: vec![CellReading::default(); n],
         })
     }
@@ -145,9 +165,14 @@ impl SkinSensor {
         }
     }
 
-    /// Fills `force_n` with each cell's share of the normal contact forces on the robot.
+    /// Fills `force_n` with each cell's share of the normal contact forces on the robot. MuJoCo
+    /// reports a flat contact between two boxes as the corners of the touching area, so the
+    /// contacts of one pair of geoms are taken together: their summed force is shared by the
+    /// cells near the box spanned by their points (a flat palm on a board: every palm cell; an
+    /// edge: the cells along it; one point: the cells around it).
     fn contact_forces<M: ModelType>(&mut self, data: &MjData<M>) {
         self.force_n.fill(0.0);
+        self.patches.clear();
         let model = data.model();
         let (group, geom_body) = (model.geom_group(), model.geom_bodyid());
         for (k, con) in data.contact().iter().enumerate() {
@@ -161,26 +186,39 @@ impl SkinSensor {
             // The contact normal points from geom1 to geom2; the force pushes geom2 along it.
             let normal = Vector3::new(con.frame[0], con.frame[1], con.frame[2]) * force[0];
             let pos = Point3::from(con.pos);
-            for (g, f) in [(g1, -normal), (g2, normal)] {
-                if group[g] == ROBOT_GROUP as i32 {
-                    self.distribute(data, geom_body[g] as usize, &pos, &f);
+            for (g, other, f) in [(g1, g2, -normal), (g2, g1, normal)] {
+                if group[g] != ROBOT_GROUP as i32 {
+                    continue;
+                }
+                match self.patches.iter_mut().find(|p| p.geoms == [g, other]) {
+                    Some(p) => {
+                        p.force += f;
+                        p.min = p.min.inf(&pos);
+                        p.max = p.max.sup(&pos);
+                    }
+                    None => self.patches.push(ContactPatch { geoms: [g, other], body: geom_body[g] as usize, force: f, min: pos, max: pos }),
                 }
             }
         }
+        for k in 0..self.patches.len() {
+            let p = self.patches[k];
+            self.distribute(data, &p);
+        }
     }
 
-    /// Splits force `f` (world, acting on body `body` at `pos`) over the body's cells near `pos`.
-    fn distribute<M: ModelType>(&mut self, data: &MjData<M>, body: usize, pos: &Point3<f64>, f: &Vector3<f64>) {
+    /// Splits the patch's force (world, acting on its robot body) over the body's cells near it.
+    fn distribute<M: ModelType>(&mut self, data: &MjData<M>, patch: &ContactPatch) {
         let r = self.contact_radius_m;
-        let range = self.body_range[body].clone();
-        let pose = body_pose(data, body);
-        let local_pos = pose.inverse_transform_point(pos);
-        let local_f = pose.inverse_transform_vector(f);
+        let range = self.body_range[patch.body].clone();
+        let pose = body_pose(data, patch.body);
+        // distance from a world point to the patch's box (world axes)
+        let to_patch = |w: Point3<f64>| (w - w.sup(&patch.min).inf(&patch.max)).norm();
+        let local_f = pose.inverse_transform_vector(&patch.force);
         let direction = local_f.normalize();
         // A cell carries a share when it is near and faces the force (pressing = along its inward
         // normal, -n): cells at right angles to it (a palm's rim under a flat contact) take none,
         // so the pressing force is not lost to them.
-        let weight = |c: &SimCell| (1.0 - (c.position - local_pos).norm() / r).max(0.0) * (-direction.dot(&c.normal)).max(0.0);
+        let weight = |c: &SimCell| (1.0 - to_patch(pose * c.position) / r).max(0.0) * (-direction.dot(&c.normal)).max(0.0);
         let total: f64 = self.by_body[range.clone()].iter().map(|&i| weight(&self.cells[i])).sum();
         if total <= 0.0 {
             return; // no skin there facing the force

@@ -1,5 +1,5 @@
 //! The closed loop with the real controller: determinism, metrics.json keys, every scenario's
-//! setup, and the parts of the outcome checks that hold today (see docs/scenarios.md).
+//! setup, and the outcome checks that hold today (see docs/scenarios.md).
 
 use skin_sim::hand_force::HandForceMap;
 use skin_sim::runner::RunTarget;
@@ -67,6 +67,32 @@ fn intentional_contact_passes_every_outcome_check() {
         assert!(c.passed, "{}: {}", c.name, c.detail);
     }
     assert!(report.checks.iter().any(|c| c.name == "hard push relieved"), "the push reaches the arm");
+}
+
+#[test]
+fn poster_phrc_passes_every_outcome_check() {
+    // The whole scene (80 s simulated): paper 003 Exp. 4, 6 N held on a leaning wall while a
+    // person pushes the arm; RMS force errors within Table 3's 0.42 N (without) and 0.80 N (with
+    // interaction), measured by MuJoCo, not the skin.
+    let report = run("poster_phrc", 80.0);
+    assert!(report.checks.iter().any(|c| c.name.contains("w/ interaction")), "the scene has interaction periods");
+    for c in &report.checks {
+        assert!(c.passed, "{}: {}", c.name, c.detail);
+    }
+}
+
+#[test]
+fn force_tracking_base_motion_tracks_the_reference_within_half_a_newton() {
+    // Paper 003 Exp. 1 for 30 s (six periods of the 4 +- 1 N sine after the contact switch at
+    // 5 s). Table 3's 0.16 N is not reached yet (docs/scenarios.md); this bounds what holds: the
+    // hand stays on the board, the mean is the reference's, the RMS error (MuJoCo's force) is
+    // below 0.6 N (13.8 N when the hierarchy used M(q) and K_1 was 2).
+    let report = run("force_tracking_base_motion", 30.0);
+    let m = report.metrics.force.as_ref().expect("the scene has force references");
+    let (mean, rms, lost) = (m.force_mean_n, m.rms_force_error_n, m.contact_lost_fraction);
+    assert!((mean - 4.0).abs() < 0.3, "mean force {mean} N, reference mean 4 N");
+    assert!(rms < 0.6, "RMS force error {rms} N");
+    assert!(lost < 0.01, "contact lost {lost} of the time");
 }
 
 #[test]

@@ -1,9 +1,9 @@
 //! [`Controller`]: one control cycle from measurements to velocity commands.
 
-use nalgebra::{DVector, Isometry3, Matrix6xX};
+use nalgebra::{DMatrix, DVector, Isometry3, Matrix6xX};
 
 use super::io::{ControllerInput, ControllerOutput, Fault};
-use super::setup::{ControllerConfig, SetupError};
+use super::setup::{ControllerConfig, HierarchyDynamics, SetupError};
 use super::task_set::{CycleContext, HandSignals, TaskSet};
 use crate::hierarchy::{HierarchySolver, LevelDiagnostics};
 use crate::model::{gravity, point_jacobian, update_kinematics, ModelData};
@@ -62,6 +62,9 @@ pub struct Controller {
     tau_k: DVector<f64>,
     tau: DVector<f64>,
     gravity: DVector<f64>,
+    /// [`HierarchyDynamics::Admittance`]: the resolver's virtual inertia and bias `g + C_a v`.
+    mass: DMatrix<f64>,
+    bias: DVector<f64>,
     /// The resolver has been reset from a valid measured state.
     started: bool,
     output: ControllerOutput,
@@ -126,6 +129,8 @@ impl Controller {
             tau_k: DVector::zeros(nv),
             tau: DVector::zeros(nv),
             gravity: DVector::zeros(nv),
+            mass: DMatrix::zeros(nv, nv),
+            bias: DVector::zeros(nv),
             started: false,
             output,
             tasks,
@@ -237,6 +242,15 @@ impl Controller {
         &self.output
     }
 
+    /// A period without usable inputs (a caller's staleness watchdog): one safe-stop step, every
+    /// command decelerates towards zero within its acceleration limit; a later [`update`]
+    /// continues from the commands reached. Before the first valid state the commands stay zero.
+    ///
+    /// [`update`]: Controller::update
+    pub fn idle(&mut self, dt_s: f64) -> &Commands {
+        self.resolver.safe_stop(dt_s)
+    }
+
     /// Lengths and finiteness of the measured state.
     fn check_state(&self, input: &ControllerInput) -> Result<(), Fault> {
         let nv = self.config.model.nv();
@@ -320,9 +334,25 @@ impl Controller {
         let posture = has_posture.then(|| self.tasks.posture.torque().as_slice());
         let (kinds, levels) = (&self.tasks.kinds, &self.tasks.levels);
         let active = order.iter().filter(|&&i| kinds[i].is_level()).map(|&i| &levels[i]);
-        self.solver
-            .solve_model(model, &mut self.data, active, posture, true, &mut self.tau_k)
-            .map_err(stage("hierarchy"))?;
+        gravity(model, &mut self.data, &mut self.gravity).map_err(stage("gravity"))?;
+        for (g, _) in self.gravity.iter_mut().zip(&self.locked).filter(|(_, &l)| l) {
+            *g = 0.0; // a locked joint's virtual dynamics stay at rest (its τ* is 0)
+        }
+        match self.config.setup.hierarchy_dynamics {
+            HierarchyDynamics::Model => self.solver.solve_model(model, &mut self.data, active, posture, true, &mut self.tau_k),
+            HierarchyDynamics::Admittance => {
+                self.resolver.virtual_dynamics(input.q, input.qd, input.dt_s, &mut self.mass, &mut self.bias);
+                for (j, _) in self.locked.iter().enumerate().filter(|(_, &l)| l) {
+                    self.bias[j] = 0.0;
+                    self.mass.row_mut(j).fill(0.0); // decoupled from the free joints (base x-y block)
+                    self.mass.column_mut(j).fill(0.0);
+                    self.mass[(j, j)] = 1.0;
+                }
+                self.bias += &self.gravity;
+                self.solver.solve(&self.mass, active, posture, Some(self.bias.as_slice()), &mut self.tau_k)
+            }
+        }
+        .map_err(stage("hierarchy"))?;
 
         // 4. blend across switches
         self.blender.sync(arrangement);
@@ -336,10 +366,6 @@ impl Controller {
         self.output.torque_norm = self.tau.norm();
 
         // 5. admittance resolver
-        gravity(model, &mut self.data, &mut self.gravity).map_err(stage("gravity"))?;
-        for (g, _) in self.gravity.iter_mut().zip(&self.locked).filter(|(_, &l)| l) {
-            *g = 0.0; // a locked joint's virtual dynamics stay at rest (its τ* is 0)
-        }
         self.resolver
             .update(self.tau.as_slice(), self.gravity.as_slice(), input.q, input.qd, input.dt_s)
             .map_err(stage("resolver"))?;

@@ -14,5 +14,5 @@ mod tests;
 
 pub use cycle::Controller;
 pub use io::{ControllerInput, ControllerOutput, Fault};
-pub use setup::{ControllerConfig, ControllerSetup, SetupError};
+pub use setup::{ControllerConfig, ControllerSetup, HierarchyDynamics, SetupError};
 pub use task_set::TaskKind;

@@ -57,6 +57,24 @@ pub struct ControllerSetup {
     /// The damped, rank-aware inverse of the hierarchy (`docs/hierarchy.md`).
     #[serde(default)]
     pub inverse: InverseParams,
+    /// The dynamics the hierarchy (paper 003 eq. 19-25) is solved with.
+    #[serde(default)]
+    pub hierarchy_dynamics: HierarchyDynamics,
+}
+
+/// Which inertia and bias the hierarchy projects with.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HierarchyDynamics {
+    /// The model's `M(q)` and `C q̇ + g`, as in paper 003 eq. (23). The resolver then executes
+    /// the torque with its own `M_a`, `C_a` (eq. 26), so the executed motion is not the one the
+    /// projection decoupled: paper 000's force levels are tuned with it.
+    #[default]
+    Model,
+    /// The resolver's virtual dynamics (`Resolver::virtual_dynamics`: `M_a`, `M_b`, bias
+    /// `g + C_a q̇`): the executed acceleration is the hierarchy's, so strict priority holds in the
+    /// motion the robot makes (paper 003's acceleration levels: hand force, wrist).
+    Admittance,
 }
 
 /// Everything a [`super::Controller`] is built from, loaded and validated.
@@ -137,11 +155,55 @@ pub enum SetupError {
     },
 }
 
+/// How many `base` files a setup may derive through (a cycle ends here with an error).
+const MAX_BASE_DEPTH: usize = 8;
+
+impl ControllerSetup {
+    /// Reads the setup file at `path`; returns it with the file's name (for errors). A file with
+    /// a `base` key (another setup file, relative to this one) holds only its differences: each
+    /// of its keys replaces the base's value of that key, and the base's paths are made relative
+    /// to this file's directory. An error names the file that sets the key at fault.
+    pub fn load(path: &Path) -> Result<(Self, String), SetupError> {
+        read_setup(path, 0)
+    }
+}
+
+/// [`ControllerSetup::load`] at `depth` bases below the file the caller named.
+fn read_setup(path: &Path, depth: usize) -> Result<(ControllerSetup, String), SetupError> {
+    let (text, source) = yaml::read_text(path)?;
+    let mut layer: serde_json::Map<String, serde_json::Value> = yaml::parse_str(&text, &source)?;
+    let Some(base) = layer.remove("base") else {
+        return Ok((yaml::parse_str(&text, &source)?, source));
+    };
+    let invalid = |key: &str, reason: String| SetupError::Invalid { file: source.clone(), key: key.into(), reason };
+    let base = base.as_str().map(PathBuf::from).ok_or_else(|| invalid("base", "must be a file name".into()))?;
+    if depth >= MAX_BASE_DEPTH {
+        return Err(invalid("base", format!("more than {MAX_BASE_DEPTH} bases (a cycle?)")));
+    }
+    let (mut merged, _) = read_setup(&path.parent().unwrap_or(Path::new(".")).join(&base), depth + 1)?;
+    // the base's file paths, relative to the base's directory, made relative to this one's
+    let base_dir = base.parent().unwrap_or(Path::new(""));
+    for p in [&mut merged.urdf, &mut merged.skin_layout, &mut merged.skin_model, &mut merged.tasks, &mut merged.supervisor, &mut merged.resolver] {
+        *p = base_dir.join(&*p);
+    }
+    let serde_json::Value::Object(mut merged) = serde_json::to_value(&merged).expect("a setup serializes") else {
+        unreachable!("a struct serializes to an object")
+    };
+    // key by key over the (valid) base, so that a bad value is named by its key
+    for (key, value) in layer {
+        let mut one = merged.clone();
+        one.insert(key.clone(), value.clone());
+        serde_json::from_value::<ControllerSetup>(serde_json::Value::Object(one)).map_err(|e| invalid(&key, e.to_string()))?;
+        merged.insert(key, value);
+    }
+    let setup = serde_json::from_value(serde_json::Value::Object(merged)).map_err(|e| invalid("base", e.to_string()))?;
+    Ok((setup, source))
+}
+
 impl ControllerConfig {
     /// Reads the setup file at `path` and everything it names (paths relative to its directory).
     pub fn load(path: &Path) -> Result<Self, SetupError> {
-        let (text, source) = yaml::read_text(path)?;
-        let setup: ControllerSetup = yaml::parse_str(&text, &source)?;
+        let (setup, source) = ControllerSetup::load(path)?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let at = |p: &Path| dir.join(p);
         let model = RobotModel::from_urdf_file(&at(&setup.urdf))?;

@@ -120,6 +120,31 @@ fn setup_errors_name_file_and_key() {
 }
 
 #[test]
+fn a_derived_setup_is_its_base_with_its_keys_replaced() {
+    let (phases, _) = ControllerSetup::load(&setup("tomm_phases")).unwrap();
+    let (table, _) = ControllerSetup::load(&setup("tomm_phases_table")).unwrap();
+    let (tomm, _) = ControllerSetup::load(&setup("tomm")).unwrap();
+    // what tomm_phases_table.yaml sets differs; everything else comes through two bases
+    assert_ne!(table.posture, phases.posture);
+    assert_eq!(ControllerSetup { posture: phases.posture.clone(), ..table }, phases);
+    assert_eq!(phases.policy, Some(crate::supervisor::Policy::Phases));
+    assert_eq!(ControllerSetup { posture: tomm.posture.clone(), policy: None, hierarchy_dynamics: tomm.hierarchy_dynamics, ..phases }, tomm);
+    Controller::from_setup_file(&setup("tomm_phases_table"), 0.0).expect("the base's relative paths resolve");
+}
+
+#[test]
+fn derived_setup_errors_name_the_file_and_key() {
+    let e = setup_error("tomm_phases", "policy: phases", "policy: phasse");
+    assert!(e.contains(".test_tomm_phases") && e.contains("`policy`") && e.contains("phasse"), "{e}");
+    let e = setup_error("tomm_phases", "policy: phases", "policy: phases\nend_efector: x");
+    assert!(e.contains("`end_efector`"), "unknown keys are errors: {e}");
+    let e = setup_error("tomm_phases", "base: tomm.yaml", "base: tomm_missing.yaml");
+    assert!(e.contains("tomm_missing.yaml"), "{e}");
+    let e = setup_error("tomm_phases", "policy: phases", "policy: phases\nend_effector: right_hnad");
+    assert!(e.contains("end_effector") && e.contains("right_hnad"), "checks after the merge: {e}");
+}
+
+#[test]
 fn task_names_map_to_kinds() {
     for (name, kind) in TaskKind::ALL {
         assert_eq!(TaskKind::from_name(name), Some(kind));

@@ -523,3 +523,37 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn virtual_dynamics_predict_what_the_resolver_executes() {
+    // A torque g + M_v a + C v (virtual_dynamics) accelerates every joint by a, the base in world
+    // axes too at any yaw and with anisotropic M_b (up to the zero-order hold: C dt / 2M, 1 % on the arms).
+    let m = model("tomm");
+    let mut p = ResolverParams::default();
+    p.base.inertia = [40.0, 20.0, 10.0];
+    let mut r = Resolver::new(&m, p).unwrap();
+    let n = m.nv();
+    let mut q = DVector::zeros(n);
+    let [bx, by, byaw] = r.base_joints().unwrap();
+    q[byaw] = 0.7;
+    let qd = DVector::from_fn(n, |i, _| 0.1 * (i as f64 + 1.0).sin());
+    r.reset(q.as_slice(), qd.as_slice()).unwrap();
+    let a = DVector::from_fn(n, |i, _| 0.5 * (i as f64 * 0.7).cos());
+    let (mut mass, mut damping) = (nalgebra::DMatrix::zeros(n, n), DVector::zeros(n));
+    r.virtual_dynamics(q.as_slice(), qd.as_slice(), BASE_DT, &mut mass, &mut damping);
+    let g = DVector::from_fn(n, |j, _| if [bx, by, byaw].contains(&j) { 0.0 } else { 3.0 }); // the arms' gravity
+    let tau = &mass * &a + &damping + &g;
+    r.update(tau.as_slice(), g.as_slice(), q.as_slice(), qd.as_slice(), BASE_DT).unwrap();
+    let c = r.commands();
+    for (&j, &v) in r.arm_joints().iter().zip(&c.joint_velocities) {
+        let acc = (v - qd[j]) / BASE_DT;
+        assert!((acc - a[j]).abs() < 0.015 * a[j].abs() + 1e-6, "joint {j}: {acc} != {}", a[j]);
+    }
+    let (s, co) = q[byaw].sin_cos();
+    let t = c.base_twist;
+    let world = [co * t[0] - s * t[1], s * t[0] + co * t[1], t[2]];
+    for (k, &j) in [bx, by, byaw].iter().enumerate() {
+        let acc = (world[k] - qd[j]) / BASE_DT;
+        assert!((acc - a[j]).abs() < 0.015 * a[j].abs() + 1e-6, "base {k}: {acc} != {}", a[j]);
+    }
+}

@@ -65,7 +65,8 @@ fn volume(shape: &Shape) -> f64 {
 /// A fixed (static) or free body with the object's primitives; a free body's mass is spread
 /// over its primitives by volume (uniform density). The geoms have contact priority 1, so the
 /// object's `friction` is the one of its contacts with the floor and the robot (MuJoCo would
-/// otherwise take the larger of the two geoms' coefficients, the floor's 1.0).
+/// otherwise take the larger of the two geoms' coefficients, the floor's 1.0) and its
+/// `contact_time_constant_s` (MuJoCo `solref`) the softness of those contacts.
 pub(super) fn object_xml(o: &ObjectSpec, xml: &mut String) {
     let parts = primitives(&o.shape);
     let _ = writeln!(
@@ -85,9 +86,10 @@ pub(super) fn object_xml(o: &ObjectSpec, xml: &mut String) {
         let attrs = shape_attrs(shape).expect("objects are primitives");
         let _ = writeln!(
             xml,
-            "      <geom {attrs} {} friction=\"{} 0.005 0.0001\" priority=\"1\" group=\"{OBJECT_GROUP}\"{density}/>",
+            "      <geom {attrs} {} friction=\"{} 0.005 0.0001\" solref=\"{} 1\" priority=\"1\" group=\"{OBJECT_GROUP}\"{density}/>",
             pose_attrs(pose),
-            o.friction
+            o.friction,
+            o.contact_time_constant_s
         );
     }
     xml.push_str("    </body>\n");

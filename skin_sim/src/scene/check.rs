@@ -140,6 +140,7 @@ fn check_object(key: &str, o: &ObjectSpec) -> Checked {
         positive(format!("{key}.mass_kg"), m)?;
     }
     non_negative(format!("{key}.friction"), o.friction)?;
+    positive(format!("{key}.contact_time_constant_s"), o.contact_time_constant_s)?;
     let shape = format!("{key}.shape");
     match &o.shape {
         ShapeSpec::Box { size_m } => size_m

@@ -165,10 +165,19 @@ pub struct ObjectSpec {
     /// Sliding friction coefficient against anything it touches.
     #[serde(default = "default_friction")]
     pub friction: f64,
+    /// Time constant of the object's contacts (MuJoCo `solref`, critically damped) \[s\]: the
+    /// contact's stiffness falls with its square. MuJoCo's default 0.02 s makes a rigid surface
+    /// (about 1e5 N/m against the TOMM palm); a larger one stands for a compliant surface, or
+    /// the soft cover of the skin pressed on it.
+    #[serde(default = "default_contact_time_constant")]
+    pub contact_time_constant_s: f64,
 }
 
 fn default_friction() -> f64 {
     1.0
+}
+fn default_contact_time_constant() -> f64 {
+    0.02
 }
 
 /// Object geometry; lengths in m, centred on the object frame (cylinders and capsules along z).

@@ -11,7 +11,6 @@ use anyhow::Context;
 use serde::{Deserialize, Serialize};
 use skin_core::controller::ControllerSetup;
 use skin_core::skin::layout::SkinLayout;
-use skin_core::skin::yaml;
 
 use super::{cpu_time, density};
 use super::figures::{self, Figures};
@@ -89,8 +88,7 @@ fn fit_sensor_rates(spec: &mut SceneSpec, timestep_s: f64) -> Vec<String> {
 /// Writes the point's controller setup (and its reduced layout) into `work`; returns the setup
 /// file and the layout the scene must use.
 fn write_variant(target: &RunTarget, point: &Point, id: usize, work: &Path) -> anyhow::Result<(PathBuf, SkinLayout)> {
-    let (text, source) = yaml::read_text(&target.controller)?;
-    let mut setup: ControllerSetup = yaml::parse_str(&text, &source)?;
+    let (mut setup, source) = ControllerSetup::load(&target.controller)?;
     let dir = target.controller.parent().unwrap_or(Path::new(".")).canonicalize()?;
     for p in [&mut setup.urdf, &mut setup.skin_model, &mut setup.tasks, &mut setup.supervisor, &mut setup.resolver] {
         *p = dir.join(&*p);

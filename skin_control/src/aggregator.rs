@@ -5,7 +5,7 @@ use r2r::visualization_msgs::msg::MarkerArray;
 use skin_core::skin::aggregate::{aggregate_patches, FusionParams, PatchWrench};
 use skin_core::skin::layout::ResolvedLayout;
 
-use crate::convert::{write_patch_array, CellBuffer, Issue, IssueCounts};
+use crate::convert::{update_cells, write_patch_array, CellBuffer, Issue, IssueCounts};
 use crate::markers::SkinMarkers;
 
 /// `ros2 param describe` texts of the skin model parameters (`skin_core::skin::params::SkinParams`,
@@ -67,7 +67,7 @@ impl Aggregator {
         fusion: &FusionParams,
         report: impl FnMut(&Issue),
     ) -> (&PatchWrenchArray, &MarkerArray) {
-        self.cells.update(&self.layout, msg, report);
+        update_cells(&mut self.cells, &self.layout, msg, report);
         let readings = self.cells.readings();
         aggregate_patches(&self.layout, readings, fusion, &mut self.wrenches)
             .expect("the cell buffer has one reading per layout cell");

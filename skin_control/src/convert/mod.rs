@@ -22,211 +22,15 @@ use r2r::builtin_interfaces::msg::Time;
 use r2r::geometry_msgs::msg::{Point, Vector3 as Vector3Msg};
 use r2r::skin_msgs::msg::{PatchWrench as PatchWrenchMsg, PatchWrenchArray, SkinCell, SkinCellArray};
 use skin_core::skin::aggregate::PatchWrench;
+pub use skin_core::skin::cell_input::{CellBuffer, CellSample, Issue, IssueCounts, IssueKind};
 use skin_core::skin::layout::ResolvedLayout;
 use skin_core::skin::signals::CellReading;
 
-/// A category of bad cell input.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum IssueKind {
-    /// A cell id that is not in the layout (the cell is ignored).
-    UnknownId,
-    /// A cell id repeated within one message (the repetition is ignored).
-    DuplicateId,
-    /// A NaN or infinite signal (read as 0: no signal).
-    NonFinite,
-    /// A finite signal outside [0, 1] (clamped).
-    OutOfRange,
-    /// A `force` array without exactly three values (missing values read as 0, extra ignored).
-    Malformed,
-}
-
-impl IssueKind {
-    /// Every kind, in the order of [`IssueCounts`].
-    pub const ALL: [IssueKind; 5] = [
-        IssueKind::UnknownId,
-        IssueKind::DuplicateId,
-        IssueKind::NonFinite,
-        IssueKind::OutOfRange,
-        IssueKind::Malformed,
-    ];
-
-    /// Short name, as used in logs and counters.
-    pub fn name(self) -> &'static str {
-        match self {
-            IssueKind::UnknownId => "unknown cell id",
-            IssueKind::DuplicateId => "duplicate cell id",
-            IssueKind::NonFinite => "non-finite signal",
-            IssueKind::OutOfRange => "signal outside [0, 1]",
-            IssueKind::Malformed => "malformed force array",
-        }
-    }
-
-    /// What the conversion did about it.
-    pub fn action(self) -> &'static str {
-        match self {
-            IssueKind::UnknownId => "cell ignored",
-            IssueKind::DuplicateId => "repetition ignored, first occurrence used",
-            IssueKind::NonFinite => "read as 0",
-            IssueKind::OutOfRange => "clamped to [0, 1]",
-            IssueKind::Malformed => "missing values read as 0, extra ones ignored",
-        }
-    }
-
-    fn index(self) -> usize {
-        self as usize
-    }
-}
-
-/// One bad value found in a `SkinCellArray`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Issue {
-    /// Its category.
-    pub kind: IssueKind,
-    /// Index of the cell in the message's `cells`.
-    pub index: usize,
-    /// The cell id.
-    pub cell_id: u32,
-    /// The field, e.g. `force[1]`, `proximity`, `cell_id`.
-    pub field: &'static str,
-    /// The offending value, for signal issues.
-    pub value: Option<f32>,
-}
-
-impl fmt::Display for Issue {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "cells[{}] (cell {}) {}",
-            self.index, self.cell_id, self.field
-        )?;
-        if let Some(v) = self.value {
-            write!(f, " = {v}")?;
-        }
-        write!(f, ": {} ({})", self.kind.name(), self.kind.action())
-    }
-}
-
-/// Number of issues per [`IssueKind`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct IssueCounts([u64; IssueKind::ALL.len()]);
-
-impl IssueCounts {
-    /// Count of `kind`.
-    pub fn get(&self, kind: IssueKind) -> u64 {
-        self.0[kind.index()]
-    }
-
-    /// Sum over all kinds.
-    pub fn total(&self) -> u64 {
-        self.0.iter().sum()
-    }
-
-    fn add(&mut self, kind: IssueKind) {
-        self.0[kind.index()] += 1;
-    }
-}
-
-impl fmt::Display for IssueCounts {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (k, kind) in IssueKind::ALL.iter().enumerate() {
-            let sep = if k == 0 { "" } else { ", " };
-            write!(f, "{sep}{}: {}", kind.name(), self.get(*kind))?;
-        }
-        Ok(())
-    }
-}
-
-const FORCE_FIELDS: [&str; 3] = ["force[0]", "force[1]", "force[2]"];
-
-/// The latest reading of every layout cell, updated from `SkinCellArray` messages.
-#[derive(Debug, Clone)]
-pub struct CellBuffer {
-    readings: Vec<CellReading>,
-    /// Number of the message that last wrote each cell: finds repeated ids without clearing a
-    /// per-message set.
-    written_by: Vec<u64>,
-    messages: u64,
-    issues: IssueCounts,
-}
-
-impl CellBuffer {
-    /// A buffer for every cell of `layout`, all readings zero.
-    pub fn new(layout: &ResolvedLayout) -> Self {
-        CellBuffer {
-            readings: vec![CellReading::default(); layout.num_cells()],
-            written_by: vec![0; layout.num_cells()],
-            messages: 0,
-            issues: IssueCounts::default(),
-        }
-    }
-
-    /// Readings indexed like `layout.cells()`, as `skin_core::skin::aggregate` takes them.
-    pub fn readings(&self) -> &[CellReading] {
-        &self.readings
-    }
-
-    /// Issues counted since the buffer was created.
-    pub fn issues(&self) -> &IssueCounts {
-        &self.issues
-    }
-
-    /// Writes the cells of `msg` (see the module doc for the rules); `report` is called for every
-    /// issue. `layout` must be the one the buffer was made for. No allocation.
-    pub fn update(
-        &mut self,
-        layout: &ResolvedLayout,
-        msg: &SkinCellArray,
-        mut report: impl FnMut(&Issue),
-    ) {
-        self.messages += 1;
-        let mut note = |issues: &mut IssueCounts, issue: Issue| {
-            issues.add(issue.kind);
-            report(&issue);
-        };
-        for (index, cell) in msg.cells.iter().enumerate() {
-            let id_issue = |kind| Issue {
-                kind,
-                index,
-                cell_id: cell.cell_id,
-                field: "cell_id",
-                value: None,
-            };
-            let Some(k) = layout.cell_index(cell.cell_id) else {
-                note(&mut self.issues, id_issue(IssueKind::UnknownId));
-                continue;
-            };
-            if self.written_by[k] == self.messages {
-                note(&mut self.issues, id_issue(IssueKind::DuplicateId));
-                continue;
-            }
-            self.written_by[k] = self.messages;
-            if cell.force.len() != 3 {
-                note(
-                    &mut self.issues,
-                    Issue {
-                        field: "force",
-                        ..id_issue(IssueKind::Malformed)
-                    },
-                );
-            }
-            let mut signal = |field: &'static str, raw: Option<&f32>| {
-                let raw = raw.copied().unwrap_or(0.0);
-                let (value, kind) = sanitize(raw);
-                if let Some(kind) = kind {
-                    let issue = Issue {
-                        field,
-                        value: Some(raw),
-                        ..id_issue(kind)
-                    };
-                    note(&mut self.issues, issue);
-                }
-                value
-            };
-            let force = [0, 1, 2].map(|j| signal(FORCE_FIELDS[j], cell.force.get(j)));
-            let proximity = signal("proximity", Some(&cell.proximity));
-            self.readings[k] = CellReading { force, proximity };
-        }
-    }
+/// Writes the cells of `msg` into `buf` (the rules of `skin_core::skin::cell_input`); `report`
+/// is called for every issue. No allocation.
+pub fn update_cells(buf: &mut CellBuffer, layout: &ResolvedLayout, msg: &SkinCellArray, report: impl FnMut(&Issue)) {
+    let samples = msg.cells.iter().map(|c| CellSample { cell_id: c.cell_id, force: &c.force, proximity: c.proximity });
+    buf.update(layout, samples, report);
 }
 
 /// Writes every layout cell's reading into `msg` (the simulation's skin driver): ids from the
@@ -244,16 +48,6 @@ pub fn write_cell_array(layout: &ResolvedLayout, readings: &[CellReading], stamp
 }
 
 /// A normalized signal into [0, 1], with the issue it had, if any.
-fn sanitize(raw: f32) -> (f64, Option<IssueKind>) {
-    if !raw.is_finite() {
-        (0.0, Some(IssueKind::NonFinite))
-    } else if !(0.0..=1.0).contains(&raw) {
-        (f64::from(raw.clamp(0.0, 1.0)), Some(IssueKind::OutOfRange))
-    } else {
-        (f64::from(raw), None)
-    }
-}
-
 /// TF frame name of patch `patch_id`'s frame {p_j}: `skin_patch_<id>`.
 pub fn patch_frame_id(patch_id: u32) -> String {
     let mut s = String::new();
@@ -474,76 +268,8 @@ mod tests {
 
     fn update(buf: &mut CellBuffer, l: &ResolvedLayout, msg: &SkinCellArray) -> Vec<Issue> {
         let mut issues = Vec::new();
-        buf.update(l, msg, |i| issues.push(*i));
+        update_cells(buf, l, msg, |i| issues.push(*i));
         issues
-    }
-
-    #[test]
-    fn cells_map_through_the_layout_and_absent_cells_keep_their_reading() {
-        let l = layout();
-        let mut buf = CellBuffer::new(&l);
-        assert!(update(&mut buf, &l, &cells(vec![cell(20, [0.5, 0.25, 1.0], 0.75)])).is_empty());
-        let k20 = l.cell_index(20).unwrap();
-        assert_eq!(
-            buf.readings()[k20],
-            CellReading {
-                force: [0.5, 0.25, 1.0],
-                proximity: 0.75
-            }
-        );
-        assert!(update(&mut buf, &l, &cells(vec![cell(10, [0.0; 3], 0.5)])).is_empty());
-        assert_eq!(
-            buf.readings()[k20].proximity,
-            0.75,
-            "absent cell keeps its last reading"
-        );
-        assert_eq!(
-            buf.readings()[l.cell_index(11).unwrap()],
-            CellReading::default()
-        );
-        assert_eq!(buf.issues().total(), 0);
-    }
-
-    #[test]
-    fn bad_input_is_sanitized_counted_and_reported() {
-        let l = layout();
-        let mut buf = CellBuffer::new(&l);
-        let msg = cells(vec![
-            cell(10, [f32::NAN, 0.5, f32::INFINITY], 1.5),
-            cell(99, [0.5; 3], 0.5),
-            cell(10, [0.9; 3], 0.9),
-            SkinCell {
-                cell_id: 11,
-                force: vec![0.3],
-                proximity: -0.1,
-                ..Default::default()
-            },
-        ]);
-        let issues = update(&mut buf, &l, &msg);
-        let r10 = buf.readings()[l.cell_index(10).unwrap()];
-        assert_eq!(
-            r10,
-            CellReading {
-                force: [0.0, 0.5, 0.0],
-                proximity: 1.0
-            },
-            "first wins"
-        );
-        let r11 = buf.readings()[l.cell_index(11).unwrap()];
-        assert_eq!(r11.force[1], 0.0);
-        assert_eq!(r11.proximity, 0.0);
-        let c = buf.issues();
-        assert_eq!(c.get(IssueKind::NonFinite), 2);
-        // proximity 1.5 of cell 10 and -0.1 of cell 11.
-        assert_eq!(c.get(IssueKind::OutOfRange), 2);
-        assert_eq!(c.get(IssueKind::UnknownId), 1);
-        assert_eq!(c.get(IssueKind::DuplicateId), 1);
-        assert_eq!(c.get(IssueKind::Malformed), 1);
-        assert_eq!(issues.len() as u64, c.total());
-        let text = issues[0].to_string();
-        assert!(text.contains("cells[0] (cell 10) force[0] = NaN"), "{text}");
-        // The same id in the next message is not a duplicate.
-        assert!(update(&mut buf, &l, &cells(vec![cell(10, [0.1; 3], 0.1)])).is_empty());
     }
 
     #[test]

@@ -12,6 +12,7 @@
 //! [`tiling`] holds the geometry of the `skin_layout` generator.
 
 pub mod aggregate;
+pub mod cell_input;
 pub mod cell_forces;
 pub mod characteristic;
 pub mod generate;

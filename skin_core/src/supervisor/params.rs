@@ -140,9 +140,13 @@ pub struct SupervisorParams {
     pub smoothing_gain_per_s: f64,
     /// Fusion weight shift (paper 003).
     pub fusion: FusionShift,
-    /// Capacity of the transition log ring buffer, `≥ 1`.
+    /// Capacity of the transition log ring buffer, in [1, 100000].
     pub log_capacity: usize,
 }
+
+/// Largest [`SupervisorParams::log_capacity`]: the log is allocated whole when the supervisor is
+/// built, so an unbounded value would abort the process there.
+const LOG_CAPACITY_MAX: usize = 100_000;
 
 /// A parameter set that is structurally or numerically invalid.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -262,11 +266,11 @@ impl SupervisorParams {
         InvalidParam::positive_finite(p, "gain", f.gain)?;
         InvalidParam::positive_finite(p, "duration_s", f.duration_s)?;
 
-        if self.log_capacity == 0 {
+        if !(1..=LOG_CAPACITY_MAX).contains(&self.log_capacity) {
             return Err(InvalidParam {
                 key: "log_capacity".into(),
-                value: 0.0,
-                reason: "must be >= 1",
+                value: self.log_capacity as f64,
+                reason: "must be in [1, 100000]",
             }
             .into());
         }

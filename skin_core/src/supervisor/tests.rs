@@ -658,6 +658,19 @@ fn other_invalid_values_are_rejected() {
     }
 }
 
+/// Fuzz finding (config_yaml): a huge `log_capacity` validated, then `Supervisor::new` panicked
+/// (capacity overflow) or aborted (allocation failure) reserving the log.
+#[test]
+fn huge_log_capacity_is_rejected_not_allocated() {
+    for huge in ["18446744073709551615", "1000000000000", "100001"] {
+        let e = load_err("log_capacity: 64", &format!("log_capacity: {huge}"));
+        assert!(e.contains("bad.yaml") && e.contains("log_capacity") && e.contains("100000"), "{e}");
+    }
+    let mut p = SupervisorParams::from_yaml_str(&shipped_text(), "s.yaml").unwrap();
+    p.log_capacity = 100_000;
+    Supervisor::new(&p, 0.0).expect("the largest capacity builds");
+}
+
 #[test]
 fn unknown_key_and_bad_policy_are_parse_errors() {
     let e = load_err("log_capacity: 64", "log_capacity: 64\nlog_capacty: 3");

@@ -1,0 +1,4 @@
+//! libFuzzer target: [`skin_fuzz::config_yaml::check`] on every input.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| skin_fuzz::config_yaml::check(data));

@@ -9,6 +9,10 @@ import pytest
 
 TOP = Path(__file__).resolve().parent.parent
 
+# A DDS domain of this test session's own (inherited by every node it starts): graphs of other
+# sessions on the same machine (a demo, a second checkout's tests) must not cross-talk.
+os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
+
 
 def target_dir() -> Path:
     """Cargo's output directory of the build under test (`make test` sets SKIN_TARGET_DIR)."""

@@ -81,7 +81,10 @@ def expected(ts):
             header=header(10, ""), mode=2, blend=0.3, ee_speed=0.012, avoidance_force=1.5,
             contact_force=12.5, torque_norm=42.0, goal_error=-1.0, tasks=[
                 task(name="contact_reaction", priority=1, error_norm=2.5, torque_norm=30.0),
-                task(name="goal", priority=2, error_norm=0.2, torque_norm=12.0)])),
+                task(name="goal", priority=2, error_norm=0.2, torque_norm=12.0)],
+            input_status=2, safe_stop_cycles=3, idle_periods=40,
+            issue_names=["/skin/cells: unknown cell id", "/scan: message refused"],
+            issue_counts=np.array([5, 0], dtype=np.uint64))),
     ]
 
 

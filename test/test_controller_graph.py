@@ -1,7 +1,7 @@
 """task_controller, priority_supervisor and skin_aggregator on TOMM over real Fast DDS, with rclpy
 as the outside peer playing robot drivers, skin and user.
 
-Checked: zero commands on every command topic before the inputs are complete; once both arms'
+Checked: zero commands on every command topic before the inputs are complete (the state says waiting); once both arms'
 joint states (two partial messages, as two UR drivers send them), odometry, a scan and skin
 cells arrive, commands in each arm's joint order and a controller state; a goal moves the right
 arm (its commands become nonzero, the state's goal error is set); the aggregator's patches and
@@ -106,13 +106,14 @@ def test_controller_graph(spawn, rclpy_node):
     assert all(v == 0.0 for m in got["left"] + got["right"] for v in m.data)
     assert all(m.linear.x == m.linear.y == m.angular.z == 0.0 for m in got["base"])
     assert [len(got[s][0].data) for s in ("left", "right")] == [6, 6]
-    assert not got["state"], "no controller state before the inputs are complete"
+    assert all(s.input_status == s.INPUT_WAITING for s in got["state"]), "waiting for the inputs"
     spin_until(rclpy_node, lambda: got["arrangement"], 30.0, "the latched arrangement")
     assert got["arrangement"][-1].task_order == ["avoidance", "goal", "contact_reaction"]
 
-    # Inputs: cycles run, the state comes; no goal yet.
+    # Inputs: cycles run, the state says so; no goal yet.
     peer.streaming = True
-    spin_until(rclpy_node, lambda: len(got["state"]) >= 5, 30.0, "/controller/state")
+    spin_until(rclpy_node, lambda: len(got["state"]) >= 5 and got["state"][-1].input_status
+               == got["state"][-1].INPUT_FRESH, 30.0, "/controller/state with fresh inputs")
     assert got["state"][-1].goal_error < 0
     names = [t.name for t in got["state"][-1].tasks]
     assert "goal" in names and "posture" in names

@@ -6,6 +6,7 @@
 
 pub mod aggregator;
 pub mod convert;
+pub mod input_health;
 pub mod markers;
 pub mod nodes;
 pub mod paths;

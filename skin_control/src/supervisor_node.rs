@@ -45,8 +45,13 @@ impl PrioritySupervisor {
     }
 
     /// Takes one controller state; returns the arrangement to publish when it differs from the
-    /// last one published (a switch, a sensing-range step, a new fusion target).
+    /// last one published (a switch, a sensing-range step, a new fusion target). States of
+    /// periods without a cycle (waiting or stale inputs) repeat old signals and are skipped: a
+    /// stalled robot must not look stuck (Table I (a) -> (b)).
     pub fn on_state(&mut self, msg: &ControllerState) -> Option<ArrangementMsg> {
+        if msg.input_status != ControllerState::INPUT_FRESH as u8 {
+            return None;
+        }
         let (t, input) = supervisor_input(msg);
         self.sup.update(t, &input);
         self.updates += 1;
@@ -99,6 +104,8 @@ mod tests {
         let first = s.on_state(&state(0.01, 0.5, 0.0, 0.0, 0.3)).unwrap();
         assert_eq!((first.mode, first.task_order[0].as_str()), (0, "avoidance"));
         assert!(s.on_state(&state(0.02, 0.5, 0.0, 0.0, 0.3)).is_none());
+        let stale = ControllerState { input_status: ControllerState::INPUT_STALE as u8, ..state(0.025, 0.5, 0.0, 9.0, 0.3) };
+        assert!(s.on_state(&stale).is_none() && s.updates() == 2, "a stale period's state is not an input");
         let hard = s.on_state(&state(0.03, 0.5, 0.0, 6.0, 0.3)).unwrap();
         assert_eq!(hard.mode, 2);
         assert_eq!(hard.switch_time, time_msg(0.03));

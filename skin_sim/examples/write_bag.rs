@@ -244,6 +244,11 @@ fn samples(v: &mut impl Visit) -> Result<()> {
                     torque_norm: 12.0,
                 },
             ],
+            input_status: 2,
+            safe_stop_cycles: 3,
+            idle_periods: 40,
+            issue_names: vec!["/skin/cells: unknown cell id".into(), "/scan: message refused".into()],
+            issue_counts: vec![5, 0],
         },
     )
 }

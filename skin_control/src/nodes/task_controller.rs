@@ -19,11 +19,10 @@ use skin_core::controller::ControllerConfig;
 
 use super::topics::*;
 use super::{file_setting, resolve, ros_now, OnceLog, Timing};
-use crate::convert::robot::{time_msg, JointIssue};
-use crate::convert::IssueKind;
+use crate::convert::robot::time_msg;
 use crate::qos;
 use crate::ros_params::StructParams;
-use crate::task_controller::{Outputs, TaskController, TaskControllerParams, Trigger, DESCRIPTIONS, START_ONLY};
+use crate::task_controller::{Idle, InputError, Outputs, TaskController, TaskControllerParams, Trigger, DESCRIPTIONS, START_ONLY};
 
 /// Node name.
 pub const NODE: &str = "task_controller";
@@ -63,11 +62,9 @@ struct Shared {
     pubs: Publishers,
     topics: Vec<String>,
     logger: String,
-    joint_log: OnceLog<6>,
-    cell_log: OnceLog<5>,
-    input_log: OnceLog<6>,
+    clock: Arc<Mutex<r2r::Clock>>,
+    fault_log: OnceLog<1>,
     publish_failed: bool,
-    zero_cycles: u64,
     stale: bool,
     timing: Timing,
 }
@@ -87,15 +84,23 @@ impl Shared {
         self.publish(|tc| tc.cycle(t_s, stamp));
         self.timing.add(start.elapsed());
         if let Some(f) = self.tc.last_fault() {
-            if self.input_log.first(5) {
+            if self.fault_log.first(0) {
                 r2r::log_warn!(&self.logger, "cycle at t = {t_s:.4} s was a safe-stop step: {f} (further ones counted)");
             }
         }
     }
 
-    fn input_error(&mut self, kind: usize, e: impl std::fmt::Display, topic: &str) {
-        if self.input_log.first(kind) {
-            r2r::log_warn!(&self.logger, "{topic}: {e} (message ignored; further ones not logged)");
+    /// The node's clock now \[s\].
+    fn now(&self) -> f64 {
+        self.clock.lock().unwrap().get_now().map(|d| d.as_secs_f64()).unwrap_or(0.0)
+    }
+
+    /// Logs a refused message the first time its kind occurs (all are counted).
+    fn refused(&self, result: std::result::Result<(), InputError>) {
+        if let Err(e) = result {
+            if e.first {
+                r2r::log_warn!(&self.logger, "{e} (message ignored; further ones are counted in /controller/state)");
+            }
         }
     }
 
@@ -123,11 +128,10 @@ impl TaskControllerHandle {
         let (cycles, faults) = s.tc.counts();
         r2r::log_info!(
             &s.logger,
-            "stopping after {cycles} cycles ({faults} safe-stop steps, {} zero-command periods): cycle {}; joint states: {}; cells: {}; zero commands sent on {}",
-            s.zero_cycles,
+            "stopping after {cycles} cycles ({faults} safe-stop steps, {} idle periods): cycle {}; input issues: {}; zero commands sent on {}",
+            s.tc.idle_periods(),
             s.timing,
-            s.tc.joint_issues(),
-            s.tc.cell_issues(),
+            s.tc.issues(),
             s.topics.join(", ")
         );
     }
@@ -204,11 +208,9 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
         pubs,
         topics: all_topics,
         logger: logger.clone(),
-        joint_log: OnceLog::default(),
-        cell_log: OnceLog::default(),
-        input_log: OnceLog::default(),
+        clock: node.get_ros_clock(),
+        fault_log: OnceLog::default(),
         publish_failed: false,
-        zero_cycles: 0,
         stale: false,
         timing: Timing::default(),
     }));
@@ -222,65 +224,63 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
 
     let js = node.subscribe::<JointState>(JOINT_STATES, qos::stream())?;
     spawn_sub(spawner, js, &shared, |s, msg| {
-        let (log, seen) = (&s.logger, &mut s.joint_log);
-        s.tc.on_joint_states(&msg, |i| {
-            if seen.first(JointIssue::ALL.iter().position(|k| *k == i.kind).unwrap_or(0)) {
-                r2r::log_warn!(log, "{JOINT_STATES}: {i} (further ones are counted, totals at shutdown)");
-            }
+        let (now, log) = (s.now(), s.logger.clone());
+        let result = s.tc.on_joint_states(&msg, now, |i| {
+            r2r::log_warn!(&log, "{JOINT_STATES}: {i} (further ones are counted in /controller/state)");
         });
+        s.refused(result);
     })?;
     if shared.borrow().tc.has_base() {
         let odom = node.subscribe::<Odometry>(ODOM, qos::stream())?;
         spawn_sub(spawner, odom, &shared, |s, msg| {
-            if let Err(e) = s.tc.on_odometry(&msg) {
-                s.input_error(0, e, ODOM);
-            }
+            let result = s.tc.on_odometry(&msg, s.now());
+            s.refused(result);
         })?;
     }
     let cells = node.subscribe::<SkinCellArray>(CELLS, qos::stream())?;
     spawn_sub(spawner, cells, &shared, |s, msg| {
-        let (log, seen) = (&s.logger, &mut s.cell_log);
-        s.tc.on_cells(&msg, |i| {
-            if seen.first(IssueKind::ALL.iter().position(|k| *k == i.kind).unwrap_or(0)) {
-                r2r::log_warn!(log, "{CELLS}: {i} (further ones are counted, totals at shutdown)");
-            }
+        let (now, log) = (s.now(), s.logger.clone());
+        let result = s.tc.on_cells(&msg, now, |i| {
+            r2r::log_warn!(&log, "{CELLS}: {i} (further ones are counted in /controller/state)");
         });
+        s.refused(result);
     })?;
     if initial.use_scan {
         let scan = node.subscribe::<LaserScan>(SCAN, qos::stream())?;
         spawn_sub(spawner, scan, &shared, |s, msg| {
-            if let Err(e) = s.tc.on_scan(&msg) {
-                s.input_error(1, e, SCAN);
-            }
+            let result = s.tc.on_scan(&msg, s.now());
+            s.refused(result);
         })?;
     }
     let goal = node.subscribe::<PoseStamped>(GOAL, qos::latched())?;
     spawn_sub(spawner, goal, &shared, |s, msg| match s.tc.on_goal(&msg) {
         Ok(()) => r2r::log_info!(&s.logger, "{GOAL}: goal ({:.3}, {:.3}, {:.3})", msg.pose.position.x, msg.pose.position.y, msg.pose.position.z),
-        Err(e) => s.input_error(2, e, GOAL),
+        Err(e) => s.refused(Err(e)),
     })?;
     let force = node.subscribe::<Float64>(FORCE_REFERENCE, qos::latched())?;
     spawn_sub(spawner, force, &shared, |s, msg| {
-        if let Err(e) = s.tc.on_force_reference(msg.data) {
-            s.input_error(3, e, FORCE_REFERENCE);
-        }
+        let result = s.tc.on_force_reference(msg.data).map(|_| ());
+        s.refused(result);
     })?;
     let arrangement = node.subscribe::<Arrangement>(ARRANGEMENT, qos::latched())?;
     spawn_sub(spawner, arrangement, &shared, |s, msg| match s.tc.on_arrangement(&msg) {
         Ok(true) => r2r::log_info!(&s.logger, "{ARRANGEMENT}: following mode {} {:?}", msg.mode, msg.task_order),
         Ok(false) => {}
-        Err(e) => s.input_error(4, e, ARRANGEMENT),
+        Err(e) => s.refused(Err(e)),
     })?;
 
     if initial.trigger == Trigger::Timer {
         let mut timer = node.create_timer(Duration::from_secs_f64(1.0 / initial.control_rate_hz))?;
-        let clock = node.get_ros_clock();
         let shared = shared.clone();
         spawner.spawn_local(async move {
             while timer.tick().await.is_ok() {
-                let now = clock.lock().unwrap().get_now().map(|d| d.as_secs_f64()).unwrap_or(0.0);
-                let timeout = params.lock().unwrap().value().input_timeout_s;
                 let mut s = shared.borrow_mut();
+                let now = s.now();
+                let (timeout, lead) = {
+                    let p = params.lock().unwrap();
+                    (p.value().input_timeout_s, p.value().max_stamp_lead_s)
+                };
+                s.tc.set_freshness(timeout, lead);
                 match s.tc.input_age(now) {
                     Some(age) if age <= timeout => {
                         if std::mem::replace(&mut s.stale, false) {
@@ -289,15 +289,15 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
                         s.run_cycle(now, &time_msg(now));
                     }
                     age => {
-                        s.zero_cycles += 1;
                         if !std::mem::replace(&mut s.stale, true) {
                             let why = match age {
                                 None => format!("waiting for {}", s.tc.missing().join(", ")),
                                 Some(a) => format!("inputs {a:.3} s old (input_timeout_s = {timeout})"),
                             };
-                            r2r::log_warn!(&s.logger, "zero commands: {why}");
+                            r2r::log_warn!(&s.logger, "commands ramp to zero: {why}");
                         }
-                        s.publish(|tc| tc.zero_outputs());
+                        let why = if age.is_none() { Idle::Waiting } else { Idle::Stale };
+                        s.publish(|tc| tc.idle_outputs(why, &time_msg(now)));
                     }
                 }
             }

@@ -360,6 +360,16 @@ pub struct ControllerState {
     pub goal_error: f64,
     /// Per-task state.
     pub tasks: Vec<TaskState>,
+    /// Input health: 0 fresh, 1 waiting, 2 stale (docs/reliability.md).
+    pub input_status: u8,
+    /// Safe-stop cycles since start.
+    pub safe_stop_cycles: u64,
+    /// Periods without a cycle since start.
+    pub idle_periods: u64,
+    /// Bad input counters: names (`<topic>: <kind>`) ...
+    pub issue_names: Vec<String>,
+    /// ... and counts.
+    pub issue_counts: Vec<u64>,
 }
 
 /// Serde for fixed arrays longer than serde's built-in 32 (the 6x6 covariances): a tuple, which

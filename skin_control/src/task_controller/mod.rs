@@ -25,8 +25,10 @@ use skin_sim::hand_force::HandForceMap;
 use crate::convert::control::{
     imposed_of, split_arms, twist_msg, write_arm_command, write_controller_state, ArmCommand,
 };
-use crate::convert::robot::{goal_pose, time_s, JointStateIssue, ScanConverter, StateBuffer};
-use crate::convert::{CellBuffer, Issue};
+use crate::convert::robot::{goal_pose, time_s, JointIssue, JointStateIssue, ScanConverter, StateBuffer};
+use crate::convert::{update_cells, CellBuffer, Issue, IssueKind};
+use crate::input_health::{IssueTable, StampGate, StampIssue};
+use crate::nodes::topics::{ARRANGEMENT, CELLS, FORCE_REFERENCE, GOAL, JOINT_STATES, ODOM, SCAN};
 
 /// What starts a control cycle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -91,8 +93,10 @@ pub struct TaskControllerParams {
     pub supervisor: SupervisorSource,
     /// Whether `/scan` is a required input (base avoidance, paper 003 eq. 15-17).
     pub use_scan: bool,
-    /// Timer mode: inputs older than this (ROS time) make the commands zero \[s\].
+    /// Timer mode: inputs older than this (ROS time) make the commands ramp to zero \[s\].
     pub input_timeout_s: f64,
+    /// Timer mode: a message stamped further ahead of the node's clock than this is refused \[s\].
+    pub max_stamp_lead_s: f64,
     /// Command topics per arm.
     pub arms: ArmsParams,
     /// Skin model (`config/skin_model.yaml`).
@@ -101,7 +105,7 @@ pub struct TaskControllerParams {
     pub tasks: TaskParams,
 }
 
-/// Keys that only the start reads (everything but `input_timeout_s`): the controller is built
+/// Keys that only the start reads (everything but `input_timeout_s` and `max_stamp_lead_s`): the controller is built
 /// from them once (`skin_core::controller::Controller` has no setter for them at run time).
 pub const START_ONLY: &[&str] = &["control_rate_hz", "trigger", "supervisor", "use_scan", "arms.", "skin.", "tasks."];
 
@@ -111,7 +115,8 @@ pub const DESCRIPTIONS: &[(&str, &str)] = &[
     ("trigger", "timer: cycles on the ROS clock; inputs: one cycle per complete input set with a common stamp (lockstep simulation) (start only)"),
     ("supervisor", "topic: follow /supervisor/arrangement; internal: the controller's own supervisor in the cycle (start only)"),
     ("use_scan", "Whether /scan is a required input (start only)"),
-    ("input_timeout_s", "Timer mode: inputs older than this [s] make the commands zero (settable)"),
+    ("input_timeout_s", "Timer mode: inputs older than this [s] make the commands ramp to zero within the acceleration limits (settable)"),
+    ("max_stamp_lead_s", "Timer mode: messages stamped more than this [s] ahead of the node's clock are refused (settable)"),
     ("arms.namespaces", "Command namespaces, one per arm: <ns>/forward_velocity_controller/commands (start only)"),
     ("arms.joint_prefixes", "Joint-name prefix of each arm's joints, pairs with arms.namespaces (start only)"),
 ];
@@ -128,6 +133,7 @@ impl TaskControllerParams {
             supervisor: SupervisorSource::Topic,
             use_scan: crate::convert::robot::base_joints(&config.model).is_some(),
             input_timeout_s: 0.1,
+            max_stamp_lead_s: 0.1,
             arms,
             skin: config.skin,
             tasks: config.tasks.clone(),
@@ -139,8 +145,10 @@ impl TaskControllerParams {
         if !(self.control_rate_hz.is_finite() && self.control_rate_hz > 0.0 && self.control_rate_hz <= 10_000.0) {
             return Err(format!("`control_rate_hz` = {}: must be in (0, 10000]", self.control_rate_hz));
         }
-        if !(self.input_timeout_s.is_finite() && self.input_timeout_s > 0.0) {
-            return Err(format!("`input_timeout_s` = {}: must be finite and > 0", self.input_timeout_s));
+        for (key, v) in [("input_timeout_s", self.input_timeout_s), ("max_stamp_lead_s", self.max_stamp_lead_s)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("`{key}` = {v}: must be finite and > 0"));
+            }
         }
         self.skin.validate().map_err(|e| format!("skin.{e}"))?;
         self.tasks.validate().map_err(|e| format!("tasks.{e}"))?;
@@ -154,27 +162,91 @@ pub struct Outputs<'a> {
     pub arms: &'a [Float64MultiArray],
     /// The base twist (None: the model has no base).
     pub base: Option<&'a Twist>,
-    /// The controller state (None when the cycle did not run the controller: zero commands).
+    /// The controller state (None only for the shutdown's zero commands).
     pub state: Option<&'a ControllerState>,
 }
 
-/// Why an input message was refused.
+/// Why an input message was refused (it is ignored as a whole, and counted).
 #[derive(Debug, Clone, PartialEq)]
 pub struct InputError {
-    /// The topic's role: `odometry`, `scan`, `goal`, `force reference`, `arrangement`.
-    pub input: &'static str,
+    /// The topic.
+    pub topic: &'static str,
     /// What is wrong (names the field).
     pub reason: String,
+    /// Whether this kind of refusal is the first on this topic (log it then; later ones are only
+    /// counted).
+    pub first: bool,
 }
 
 impl std::fmt::Display for InputError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}: {}", self.input, self.reason)
+        write!(f, "{}: {}", self.topic, self.reason)
     }
 }
 
-fn refuse(input: &'static str) -> impl FnOnce(String) -> InputError {
-    move |reason| InputError { input, reason }
+/// Where the input status of `/controller/state` comes from when no cycle ran.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Idle {
+    /// A required input has not arrived yet.
+    Waiting,
+    /// An input is older than `input_timeout_s`.
+    Stale,
+}
+
+/// The timed inputs, each with a stamp gate.
+#[derive(Debug, Clone, Copy)]
+enum Timed {
+    Joints,
+    Odometry,
+    Cells,
+    Scan,
+}
+
+const TIMED_TOPICS: [&str; 4] = [JOINT_STATES, ODOM, CELLS, SCAN];
+const REFUSED: &str = "message refused";
+
+/// Counters of every input issue ([`IssueTable`], in `/controller/state`) and the stamp gates.
+struct Health {
+    table: IssueTable,
+    /// First counter of the [`JointIssue`] kinds and of the cell [`IssueKind`]s.
+    joint_kinds: usize,
+    cell_kinds: usize,
+    /// Per timed input: its gate and its first [`StampIssue`] counter.
+    stamps: [(StampGate, usize); 4],
+    /// The `message refused` counter of each topic that refuses whole messages.
+    refused: [(&'static str, usize); 5],
+    idle_periods: u64,
+}
+
+impl Health {
+    fn new() -> Self {
+        let mut table = IssueTable::default();
+        let joint_kinds = table.register(JOINT_STATES, JointIssue::ALL.map(JointIssue::name));
+        let cell_kinds = table.register(CELLS, IssueKind::ALL.map(IssueKind::name));
+        let stamps = TIMED_TOPICS.map(|t| (StampGate::default(), table.register(t, StampIssue::ALL.map(StampIssue::name))));
+        let refused = [ODOM, SCAN, GOAL, FORCE_REFERENCE, ARRANGEMENT].map(|t| (t, table.register(t, [REFUSED])));
+        Health { table, joint_kinds, cell_kinds, stamps, refused, idle_periods: 0 }
+    }
+
+    /// The stamp check of `input` (`now_s`: the clock to compare with, if any).
+    fn check_stamp(&mut self, input: Timed, stamp: &Time, now_s: Option<f64>, max_lead_s: f64) -> Result<(), InputError> {
+        let (gate, first) = &mut self.stamps[input as usize];
+        gate.check(stamp, now_s, max_lead_s).map_err(|issue| {
+            let k = *first + issue as usize;
+            let clock = now_s.map_or(String::new(), |n| format!(", clock {n:.6} s"));
+            InputError {
+                topic: TIMED_TOPICS[input as usize],
+                reason: format!("header.stamp {:.6} s: {}{clock}", time_s(stamp), issue.name()),
+                first: self.table.count(k),
+            }
+        })
+    }
+
+    /// Counts a refused message of `topic`.
+    fn refuse(&mut self, topic: &'static str) -> impl FnOnce(String) -> InputError + '_ {
+        let k = self.refused.iter().find(|(t, _)| *t == topic).map(|(_, k)| *k).expect("a topic that refuses messages");
+        move |reason| InputError { topic, reason, first: self.table.count(k) }
+    }
 }
 
 /// The task controller: inputs buffered, one cycle on demand.
@@ -197,6 +269,7 @@ pub struct TaskController {
     state_msg: ControllerState,
     cycles: u64,
     faults: u64,
+    health: Health,
 }
 
 impl TaskController {
@@ -233,6 +306,7 @@ impl TaskController {
             last_cycle: None,
             cycles: 0,
             faults: 0,
+            health: Health::new(),
             params,
             controller,
         })
@@ -263,57 +337,90 @@ impl TaskController {
         (self.cycles, self.faults)
     }
 
-    /// Joint state input issues so far.
-    pub fn joint_issues(&self) -> &crate::convert::robot::JointIssueCounts {
-        self.state.issues()
+    /// Takes the run-time settable keys as the parameter server holds them now.
+    pub fn set_freshness(&mut self, input_timeout_s: f64, max_stamp_lead_s: f64) {
+        self.params.input_timeout_s = input_timeout_s;
+        self.params.max_stamp_lead_s = max_stamp_lead_s;
     }
 
-    /// Skin cell input issues so far.
-    pub fn cell_issues(&self) -> &crate::convert::IssueCounts {
-        self.cells.issues()
+    /// Every input issue counted so far (also in `/controller/state`).
+    pub fn issues(&self) -> &IssueTable {
+        &self.health.table
     }
 
-    /// `/joint_states`.
-    pub fn on_joint_states(&mut self, msg: &JointState, report: impl FnMut(&JointStateIssue)) {
-        self.state.update_joints(msg, report);
+    /// Control periods without a cycle (waiting or stale inputs).
+    pub fn idle_periods(&self) -> u64 {
+        self.health.idle_periods
     }
 
-    /// `/base/odom`.
-    pub fn on_odometry(&mut self, msg: &Odometry) -> Result<(), InputError> {
-        self.state.update_odometry(msg).map_err(refuse("odometry"))
+    /// The clock the stamp checks compare with: the node's in timer mode; none in inputs mode
+    /// (lockstep: the stamps are the simulation's and only their order is checked).
+    fn clock(&self, now_s: f64) -> Option<f64> {
+        (self.params.trigger == Trigger::Timer).then_some(now_s)
     }
 
-    /// `/skin/cells`.
-    pub fn on_cells(&mut self, msg: &SkinCellArray, report: impl FnMut(&Issue)) {
-        self.cells.update(&self.controller.config().layout, msg, report);
+    /// `/joint_states` at node time `now_s`; `report` gets the first issue of each kind (all are
+    /// counted).
+    pub fn on_joint_states(&mut self, msg: &JointState, now_s: f64, mut report: impl FnMut(&JointStateIssue)) -> Result<(), InputError> {
+        let lead = self.params.max_stamp_lead_s;
+        self.health.check_stamp(Timed::Joints, &msg.header.stamp, self.clock(now_s), lead)?;
+        let (table, first) = (&mut self.health.table, self.health.joint_kinds);
+        self.state.update_joints(msg, |i| {
+            if table.count(first + i.kind as usize) {
+                report(i);
+            }
+        });
+        Ok(())
+    }
+
+    /// `/base/odom` at node time `now_s`.
+    pub fn on_odometry(&mut self, msg: &Odometry, now_s: f64) -> Result<(), InputError> {
+        let lead = self.params.max_stamp_lead_s;
+        self.health.check_stamp(Timed::Odometry, &msg.header.stamp, self.clock(now_s), lead)?;
+        self.state.update_odometry(msg).map_err(self.health.refuse(ODOM))
+    }
+
+    /// `/skin/cells` at node time `now_s`; `report` gets the first issue of each kind.
+    pub fn on_cells(&mut self, msg: &SkinCellArray, now_s: f64, mut report: impl FnMut(&Issue)) -> Result<(), InputError> {
+        let lead = self.params.max_stamp_lead_s;
+        self.health.check_stamp(Timed::Cells, &msg.header.stamp, self.clock(now_s), lead)?;
+        let (table, first) = (&mut self.health.table, self.health.cell_kinds);
+        update_cells(&mut self.cells, &self.controller.config().layout, msg, |i| {
+            if table.count(first + i.kind as usize) {
+                report(i);
+            }
+        });
         self.cells_stamp = Some(msg.header.stamp.clone());
+        Ok(())
     }
 
-    /// `/scan`.
-    pub fn on_scan(&mut self, msg: &LaserScan) -> Result<(), InputError> {
+    /// `/scan` at node time `now_s`.
+    pub fn on_scan(&mut self, msg: &LaserScan, now_s: f64) -> Result<(), InputError> {
+        let lead = self.params.max_stamp_lead_s;
+        self.health.check_stamp(Timed::Scan, &msg.header.stamp, self.clock(now_s), lead)?;
         self.scan_stamp = Some(msg.header.stamp.clone());
-        self.scan.update(msg).map_err(refuse("scan"))
+        self.scan.update(msg).map_err(self.health.refuse(SCAN))
     }
 
     /// `/goal`: the end-effector goal in the world frame.
     pub fn on_goal(&mut self, msg: &PoseStamped) -> Result<(), InputError> {
-        let pose = goal_pose(msg).map_err(refuse("goal"))?;
-        self.controller.set_goal(Some(pose)).map_err(|f| InputError { input: "goal", reason: f.to_string() })
+        let pose = goal_pose(msg).map_err(self.health.refuse(GOAL))?;
+        self.controller.set_goal(Some(pose)).map_err(|f| self.health.refuse(GOAL)(f.to_string()))
     }
 
     /// The hand force reference \[N\], mapped to the hand signal `f_c,d` of paper 003 eq. (9)
     /// by `skin_sim::hand_force::HandForceMap` (an even contact on the palm cells). Returns the
     /// signal given.
     pub fn on_force_reference(&mut self, force_n: f64) -> Result<f64, InputError> {
-        let map = self.hand_map.as_ref().ok_or_else(|| InputError {
-            input: "force reference",
-            reason: "the controller setup's hand_patches have no cell facing along the end effector's z axis".into(),
-        })?;
+        let Some(map) = self.hand_map.as_ref() else {
+            let why = "the controller setup's hand_patches have no cell facing along the end effector's z axis";
+            return Err(self.health.refuse(FORCE_REFERENCE)(why.into()));
+        };
         if !(force_n.is_finite() && force_n >= 0.0) {
-            return Err(InputError { input: "force reference", reason: format!("data = {force_n}: must be finite and >= 0 N") });
+            return Err(self.health.refuse(FORCE_REFERENCE)(format!("data = {force_n}: must be finite and >= 0 N")));
         }
         let signal = map.signal(force_n);
-        self.controller.set_hand_force_reference(signal).map_err(|f| InputError { input: "force reference", reason: f.to_string() })?;
+        self.controller.set_hand_force_reference(signal).map_err(|f| self.health.refuse(FORCE_REFERENCE)(f.to_string()))?;
         Ok(signal)
     }
 
@@ -328,8 +435,8 @@ impl TaskController {
             let names = params.arrangements.by_mode();
             names[mode as usize].1.to_vec()
         };
-        let imposed = imposed_of(msg, configured).map_err(refuse("arrangement"))?;
-        self.controller.impose_arrangement(imposed).map_err(|e| InputError { input: "arrangement", reason: e.to_string() })?;
+        let imposed = imposed_of(msg, configured).map_err(self.health.refuse(ARRANGEMENT))?;
+        self.controller.impose_arrangement(imposed).map_err(|e| self.health.refuse(ARRANGEMENT)(e.to_string()))?;
         Ok(true)
     }
 
@@ -384,13 +491,32 @@ impl TaskController {
         self.stamps().map(|s| s.map(|t| now_s - time_s(t))).try_fold(0.0f64, |a, age| age.map(|x| a.max(x)))
     }
 
-    /// Zero commands on every output (no controller state).
+    /// Zero commands on every output, no controller state: the last messages at shutdown.
     pub fn zero_outputs(&mut self) -> Outputs<'_> {
         for (a, m) in self.arms.iter().zip(&mut self.arm_msgs) {
             write_arm_command(a, &[], m);
         }
         self.twist = twist_msg([0.0; 3]);
         Outputs { arms: &self.arm_msgs, base: self.needs_odom.then_some(&self.twist), state: None }
+    }
+
+    /// A period without a cycle (`why`): the commands ramp towards zero within the acceleration
+    /// limits (`Controller::idle`; zero before the first cycle); the state keeps the last cycle's
+    /// values with the input status and counters of now.
+    pub fn idle_outputs(&mut self, why: Idle, stamp: &Time) -> Outputs<'_> {
+        self.health.idle_periods += 1;
+        let c = self.controller.idle(1.0 / self.params.control_rate_hz);
+        for (a, m) in self.arms.iter().zip(&mut self.arm_msgs) {
+            write_arm_command(a, &c.joint_velocities, m);
+        }
+        self.twist = twist_msg(c.base_twist);
+        self.state_msg.header.stamp = stamp.clone();
+        self.state_msg.input_status = match why {
+            Idle::Waiting => ControllerState::INPUT_WAITING as u8,
+            Idle::Stale => ControllerState::INPUT_STALE as u8,
+        };
+        self.write_health();
+        Outputs { arms: &self.arm_msgs, base: self.needs_odom.then_some(&self.twist), state: Some(&self.state_msg) }
     }
 
     /// One control cycle at `t_s` with the buffered inputs (call only on a complete input set).
@@ -416,8 +542,16 @@ impl TaskController {
         let c = &self.controller;
         let sup = c.supervisor();
         write_controller_state(c.output(), sup.tasks(), sup.arrangement().task_order(), c.level_diagnostics(), stamp, &mut self.state_msg);
+        self.state_msg.input_status = ControllerState::INPUT_FRESH as u8;
+        self.write_health();
         self.last_cycle = Some(stamp.clone());
         Outputs { arms: &self.arm_msgs, base: self.needs_odom.then_some(&self.twist), state: Some(&self.state_msg) }
+    }
+
+    fn write_health(&mut self) {
+        self.state_msg.safe_stop_cycles = self.faults;
+        self.state_msg.idle_periods = self.health.idle_periods;
+        self.health.table.write(&mut self.state_msg);
     }
 
     /// The fault text of the last cycle, if it was a safe-stop step.
@@ -425,3 +559,6 @@ impl TaskController {
         self.controller.output().fault.map(|f| f.to_string())
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,156 @@
+//! The task controller's input health (docs/reliability.md): a stamp check per timed input and
+//! one counter per kind of rejected or sanitized input, published in `/controller/state`.
+use std::fmt;
+
+use r2r::builtin_interfaces::msg::Time;
+use r2r::skin_msgs::msg::ControllerState;
+
+use crate::convert::robot::time_s;
+
+/// Why a message's stamp was refused (the whole message is ignored).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StampIssue {
+    /// Older than the last accepted message of the same input: a reordered or replayed message
+    /// would move the state back in time.
+    OutOfOrder,
+    /// Ahead of the node's clock by more than `max_stamp_lead_s`: a sender with a wrong clock,
+    /// whose messages would look fresh for too long.
+    Future,
+}
+
+impl StampIssue {
+    /// Every kind, in counter order.
+    pub const ALL: [StampIssue; 2] = [StampIssue::OutOfOrder, StampIssue::Future];
+
+    /// Short name for logs and counters.
+    pub fn name(self) -> &'static str {
+        match self {
+            StampIssue::OutOfOrder => "stamp out of order",
+            StampIssue::Future => "stamp in the future",
+        }
+    }
+}
+
+/// The stamp check of one timed input: its messages must not go back in time nor run ahead of
+/// the clock.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StampGate {
+    last_s: Option<f64>,
+}
+
+impl StampGate {
+    /// Accepts `stamp` unless it is older than the last accepted one, or more than `max_lead_s`
+    /// ahead of `now_s` (`None`: no clock to compare with, as in lockstep). An equal stamp is
+    /// accepted: a resent period.
+    pub fn check(&mut self, stamp: &Time, now_s: Option<f64>, max_lead_s: f64) -> Result<(), StampIssue> {
+        let t = time_s(stamp);
+        if self.last_s.is_some_and(|last| t < last) {
+            return Err(StampIssue::OutOfOrder);
+        }
+        if now_s.is_some_and(|now| t > now + max_lead_s) {
+            return Err(StampIssue::Future);
+        }
+        self.last_s = Some(t);
+        Ok(())
+    }
+}
+
+/// Counters of bad input, one per `"<topic>: <kind>"`, in the fixed order of registration.
+#[derive(Debug, Clone, Default)]
+pub struct IssueTable {
+    names: Vec<String>,
+    counts: Vec<u64>,
+}
+
+impl IssueTable {
+    /// Adds a counter per kind of `topic`; returns the index of the first (the others follow).
+    pub fn register<'a>(&mut self, topic: &str, kinds: impl IntoIterator<Item = &'a str>) -> usize {
+        let first = self.names.len();
+        for kind in kinds {
+            self.names.push(format!("{topic}: {kind}"));
+            self.counts.push(0);
+        }
+        first
+    }
+
+    /// Counts one issue of counter `k`; true the first time (the time to log it).
+    pub fn count(&mut self, k: usize) -> bool {
+        self.counts[k] += 1;
+        self.counts[k] == 1
+    }
+
+    /// Count of counter `k`.
+    pub fn get(&self, k: usize) -> u64 {
+        self.counts[k]
+    }
+
+    /// Count of the counter named `name` (`"<topic>: <kind>"`), if there is one.
+    pub fn by_name(&self, name: &str) -> Option<u64> {
+        self.names.iter().position(|n| n == name).map(|k| self.counts[k])
+    }
+
+    /// Sum of all counters.
+    pub fn total(&self) -> u64 {
+        self.counts.iter().sum()
+    }
+
+    /// Writes every counter into `msg.issue_names` / `msg.issue_counts` (the names only once).
+    pub fn write(&self, msg: &mut ControllerState) {
+        if msg.issue_names.len() != self.names.len() {
+            msg.issue_names.clone_from(&self.names);
+        }
+        msg.issue_counts.clear();
+        msg.issue_counts.extend_from_slice(&self.counts);
+    }
+}
+
+/// The counters that are not zero, `name: count` separated by `; ` (`none` when all are).
+impl fmt::Display for IssueTable {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut seen = self.names.iter().zip(&self.counts).filter(|(_, &c)| c > 0).peekable();
+        if seen.peek().is_none() {
+            return write!(f, "none");
+        }
+        for (k, (name, count)) in seen.enumerate() {
+            let sep = if k == 0 { "" } else { "; " };
+            write!(f, "{sep}{name}: {count}")?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::convert::robot::time_msg;
+
+    #[test]
+    fn stamps_must_not_go_back_nor_run_ahead() {
+        let mut gate = StampGate::default();
+        assert_eq!(gate.check(&time_msg(10.0), Some(10.0), 0.05), Ok(()));
+        assert_eq!(gate.check(&time_msg(10.0), Some(10.01), 0.05), Ok(()), "a resent period");
+        assert_eq!(gate.check(&time_msg(9.99), Some(10.02), 0.05), Err(StampIssue::OutOfOrder));
+        assert_eq!(gate.check(&time_msg(10.2), Some(10.1), 0.05), Err(StampIssue::Future));
+        assert_eq!(gate.check(&time_msg(10.2), None, 0.05), Ok(()), "no clock: only the order");
+        assert_eq!(gate.check(&time_msg(10.1), None, 0.05), Err(StampIssue::OutOfOrder), "the refused stamps did not count, 10.2 did");
+    }
+
+    #[test]
+    fn the_table_counts_by_topic_and_kind() {
+        let mut t = IssueTable::default();
+        let a = t.register("/a", ["x", "y"]);
+        let b = t.register("/b", ["z"]);
+        assert_eq!((a, b), (0, 2));
+        assert!(t.count(a + 1));
+        assert!(!t.count(a + 1));
+        assert!(t.count(b));
+        assert_eq!((t.get(a), t.get(a + 1), t.total()), (0, 2, 3));
+        assert_eq!(t.by_name("/a: y"), Some(2));
+        assert_eq!(t.to_string(), "/a: y: 2; /b: z: 1");
+        let mut msg = ControllerState::default();
+        t.write(&mut msg);
+        assert_eq!(msg.issue_names, ["/a: x", "/a: y", "/b: z"]);
+        assert_eq!(msg.issue_counts, [0, 2, 1]);
+        assert_eq!(IssueTable::default().to_string(), "none");
+    }
+}

@@ -10,12 +10,13 @@ MSGS_STAMP := $(DEPS)/ros/install/share/skin_msgs/package.xml
 MSG_SRCS := $(wildcard skin_msgs/msg/*.msg skin_msgs/srv/*.srv) skin_msgs/CMakeLists.txt skin_msgs/package.xml
 CARGO_PROFILE ?= dev
 
-.PHONY: help bootstrap msgs build test test-rust test-integration run demo bench study clean
+.PHONY: help bootstrap msgs build test test-rust test-integration run demo bench study clean fuzz test-fuzz
 
 help:
 	@echo "make demo   bootstrap, build, run the main job: the intentional_contact scenario (see README.md)"
 	@echo "make run SCENE=<name>  run one scenario (skin_sim list), outputs in out/<name>/"
 	@echo "make test   bootstrap, build, run every test suite (cargo tests + test/ integration tests)"
+	@echo "make fuzz   fuzz skin_core with libFuzzer on stable, FUZZ_SECONDS per target (default 600; docs/fuzzing.md)"
 	@echo "make bench  run the benchmarks; figures in out/bench/summary.json"
 	@echo "make study  speed/accuracy study (rate, timestep, skin density, inverse damping): out/study/results.json,"
 	@echo "            docs/tradeoffs.md and docs/tradeoffs/*.png; STUDY_ARGS=--full for the whole grid (long)"
@@ -32,6 +33,8 @@ $(MSGS_STAMP): $(MSG_SRCS) | bootstrap
 	    --build-base build --install-base install --event-handlers console_cohesion- console_stderr- \
 	    --cmake-args -DPython3_EXECUTABLE=$(DEPS)/venv/bin/python -DBUILD_TESTING=OFF \
 	    > $(DEPS)/ros/colcon.log 2>&1 || { tail -40 $(DEPS)/ros/colcon.log; echo "colcon build of skin_msgs failed; full log: .deps/ros/colcon.log"; exit 1; }
+	@# r2r caches its generated bindings by environment only: drop them so changed messages are seen
+	@$(ENV) cargo clean --quiet -p r2r_msg_gen -p r2r
 	@touch $@
 
 msgs: bootstrap $(MSGS_STAMP)
@@ -48,8 +51,18 @@ test-integration: build
 	@echo "[make] integration tests (test/, pytest with rclpy, rosbags, pinocchio, MuJoCo as outside peers)"
 	@$(ENV) SKIN_TARGET_DIR=$(TOP)/target/debug python -m pytest -q test
 
-test: test-rust test-integration
+test: test-rust test-integration test-fuzz
 	@echo "[make] all test suites passed"
+
+# Coverage-guided fuzzing of skin_core on the stable toolchain (docs/fuzzing.md); `make test` runs
+# each target briefly. Builds into target/fuzz; exits non-zero on a finding.
+FUZZ_SECONDS ?= 600
+fuzz: bootstrap
+	@scripts/fuzz $(FUZZ_SECONDS)
+
+test-fuzz: bootstrap
+	@echo "[make] fuzz (20 s per target)"
+	@scripts/fuzz 20
 
 # One closed-loop scenario (skin_sim list names them); metrics.json and summary.txt in out/$(SCENE)/.
 # The debug profile is fast enough (opt-level 1): 20-90 s scenes run in 1-5 s.

@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
-"""The ROS graph's figures for out/bench/summary.json (issue 6), with the binaries `make build`
-made (debug profile: opt-level 1 for our crates, 2 for dependencies):
+"""The ROS graph's figures for out/bench/summary.json (issue 6), with the release binaries
+`scripts/bench` builds:
 
 - ros_latency_p50_us, ros_latency_p99_us: task_controller (TOMM, trigger:=inputs) and the
   ros_latency probe: a 718-cell /skin/cells at 250 Hz to the right arm's command that uses it;
 - ros_lockstep_realtime_factor: intentional_contact through mujoco_sim --lockstep and
-  task_controller (4 s of simulation), as three processes on loopback.
+  task_controller (4 s of simulation), two processes on loopback;
+- ros_lockstep_realtime_factor_stack: the same composed in skin_stack (make demo's graph).
 
 usage: bench_graph.py TARGET_DIR OUT_JSON   (other figures already in OUT_JSON are kept)"""
 import json
@@ -53,13 +54,22 @@ def lockstep(bins: Path) -> dict:
     return {"ros_lockstep_realtime_factor": round(rtf, 2)}
 
 
+def stack(bins: Path) -> dict:
+    with tempfile.TemporaryDirectory() as tmp:
+        record = Path(tmp) / "stack.json"
+        subprocess.run([bins / "skin_stack", "--scene", "intentional_contact", "--lockstep", "--internal-supervisor",
+                        "--duration", "4", "--record", record], check=True, capture_output=True, timeout=300)
+        rtf = json.loads(record.read_text())["realtime_factor"]
+    return {"ros_lockstep_realtime_factor_stack": round(rtf, 2)}
+
+
 def main() -> int:
     if len(sys.argv) != 3:
         print(__doc__, file=sys.stderr)
         return 2
     bins, out = Path(sys.argv[1]), Path(sys.argv[2])
     summary = json.loads(out.read_text()) if out.is_file() else {}
-    for name, run in (("latency", latency), ("lockstep", lockstep)):
+    for name, run in (("latency", latency), ("lockstep", lockstep), ("skin_stack lockstep", stack)):
         figures = run(bins)
         print(f"[bench] graph {name}: {figures}")
         summary.update(figures)

@@ -11,13 +11,16 @@ use r2r::geometry_msgs::msg::{PoseStamped, Twist};
 use r2r::nav_msgs::msg::Odometry;
 use r2r::rosgraph_msgs::msg::Clock;
 use r2r::sensor_msgs::msg::{JointState, LaserScan};
-use r2r::skin_msgs::msg::SkinCellArray;
+use r2r::skin_msgs::msg::{ControllerState, SkinCellArray};
 use r2r::std_msgs::msg::Float64MultiArray;
 use serde::Serialize;
+use skin_core::skin::signals::CellReading;
+use skin_core::supervisor::Mode;
+use skin_sim::runner::Decision;
 use skin_sim::scene::Scene;
 use skin_sim::world::World;
 
-use crate::convert::control::{read_arm_command, split_arms, twist_of, ArmCommand};
+use crate::convert::control::{read_arm_command, split_arms, supervisor_input, twist_of, ArmCommand};
 use crate::convert::robot::{base_joints, time_msg, write_goal, write_joint_state, write_odometry, BaseState};
 use crate::convert::write_cell_array;
 
@@ -35,7 +38,8 @@ pub struct SimMessages {
     pub odom: Option<Odometry>,
     /// `/scan` (None: no LIDAR).
     pub scan: Option<LaserScan>,
-    /// `/skin/cells`, every cell (None: no skin).
+    /// `/skin/cells`: the cells that read something or changed since the last message (the first
+    /// has every cell; None: no skin).
     pub cells: Option<SkinCellArray>,
     /// `/goal`, when a scene goal starts in this period.
     pub goal: Option<PoseStamped>,
@@ -54,6 +58,31 @@ pub struct AppliedCommand {
     pub base: [f64; 3],
 }
 
+/// The controller's decision of one period as the graph carries it, for a skin_sim record: its
+/// `/controller/state` answering the period, the commands the simulation applied,
+/// `safe_stops_before` (the state's `safe_stop_cycles` of the period before: a rise marks a
+/// safe-stop step), the arrangement's fusion weight and the round trip \[µs\].
+pub fn decision(
+    state: &ControllerState,
+    applied: &AppliedCommand,
+    safe_stops_before: u64,
+    fusion_weight: f64,
+    round_trip_us: f64,
+) -> Result<Decision, String> {
+    let mode = Mode::from_u8(state.mode).ok_or_else(|| format!("/controller/state: mode = {}: not an Arrangement.MODE_* constant", state.mode))?;
+    Ok(Decision {
+        joint_velocities: applied.joints.clone(),
+        base_twist: applied.base,
+        mode,
+        blend: state.blend,
+        fusion_weight,
+        signals: supervisor_input(state).1,
+        torque_norm: state.torque_norm,
+        fault: (state.safe_stop_cycles > safe_stops_before).then(|| "safe-stop step (/controller/state)".to_string()),
+        compute_us: round_trip_us,
+    })
+}
+
 /// A world and its message interface.
 pub struct SimBridge {
     world: World,
@@ -69,6 +98,8 @@ pub struct SimBridge {
     goals: Vec<(f64, Isometry3<f64>)>,
     next_goal: usize,
     msgs: SimMessages,
+    /// The readings as last published (empty before the first message).
+    sent_cells: Vec<CellReading>,
 }
 
 impl SimBridge {
@@ -110,6 +141,7 @@ impl SimBridge {
             goals,
             next_goal: 0,
             msgs: SimMessages::default(),
+            sent_cells: Vec::new(),
             world,
         })
     }
@@ -175,9 +207,11 @@ impl SimBridge {
             }
             _ => None,
         };
+        let sent = &mut self.sent_cells;
         m.cells = w.scene().skin.as_ref().map(|skin| {
             let mut c = m.cells.take().unwrap_or_default();
             write_cell_array(&skin.layout, w.skin_readings(), &stamp, &mut c);
+            keep_events(&mut c, w.skin_readings(), sent);
             c
         });
         m.goal = None;
@@ -220,6 +254,23 @@ impl SimBridge {
     }
 }
 
+/// Keeps in `msg` (every cell, layout order) the cells an event-driven skin sends: those that read
+/// something, or changed since `sent` (the last message's readings, updated here). A subscriber
+/// that keeps each cell's last reading and reads zero before the first (`convert::CellBuffer`)
+/// sees every cell as if all were sent, also when it joins late; the message shrinks from every
+/// cell to the few near something, which is most of the graph's serialization cost.
+fn keep_events(msg: &mut SkinCellArray, readings: &[CellReading], sent: &mut Vec<CellReading>) {
+    let zero = CellReading::default();
+    let mut k = 0;
+    msg.cells.retain(|_| {
+        let r = readings[k];
+        k += 1;
+        r != zero || sent.get(k - 1) != Some(&r)
+    });
+    sent.clear();
+    sent.extend_from_slice(readings);
+}
+
 /// The graph's loop in one process, without DDS: the [`SimBridge`]'s messages into a
 /// [`crate::task_controller::TaskController`] (every message conversion of the graph, in the
 /// same order), its commands back, for `cycles` periods. What the lockstep graph must reproduce
@@ -238,16 +289,18 @@ pub fn run_in_process(
         if let Some(f) = m.force_n {
             let _ = tc.on_force_reference(f);
         }
+        // trigger `inputs`: the stamps are checked for their order only, the clock is unused
+        let now = 0.0;
         if let Some(o) = &m.odom {
-            let _ = tc.on_odometry(o);
+            let _ = tc.on_odometry(o, now);
         }
         if let Some(s) = &m.scan {
-            let _ = tc.on_scan(s);
+            let _ = tc.on_scan(s, now);
         }
         if let Some(c) = &m.cells {
-            tc.on_cells(c, |_| {});
+            let _ = tc.on_cells(c, now, |_| {});
         }
-        tc.on_joint_states(&m.joints, |_| {});
+        let _ = tc.on_joint_states(&m.joints, now, |_| {});
         let stamp = tc.ready_stamp().expect("a complete input set every period");
         let t = crate::convert::robot::time_s(&stamp);
         let o = tc.cycle(t, &stamp);
@@ -269,10 +322,37 @@ pub fn run_in_process(
 mod tests {
     use super::*;
     use crate::ros_params::flatten;
+    use r2r::skin_msgs::msg::SkinCell;
     use crate::task_controller::{SupervisorSource, TaskController, TaskControllerParams, Trigger};
     use skin_core::controller::ControllerConfig;
     use skin_sim::closed_loop::ClosedLoop;
     use skin_sim::runner::RunTarget;
+
+    /// The event-driven cells: all in the first message, then those that read something or
+    /// changed (a cell back to zero once), never an unchanged zero one.
+    #[test]
+    fn cell_messages_carry_the_active_and_changed_cells() {
+        let layout_of = |n: u32| SkinCellArray { cells: (1..=n).map(|id| SkinCell { cell_id: id, ..Default::default() }).collect(), ..Default::default() };
+        let mut sent = Vec::new();
+        let ids = |m: &SkinCellArray| m.cells.iter().map(|c| c.cell_id).collect::<Vec<_>>();
+        let zero = CellReading::default();
+        let touched = CellReading::uniform(0.0, 0.5);
+        let mut m = layout_of(4);
+        keep_events(&mut m, &[zero, touched, zero, zero], &mut sent);
+        assert_eq!(ids(&m), [1, 2, 3, 4]);
+        let mut m = layout_of(4);
+        keep_events(&mut m, &[zero, touched, zero, touched], &mut sent);
+        assert_eq!(ids(&m), [2, 4]);
+        let mut m = layout_of(4);
+        keep_events(&mut m, &[zero, zero, zero, touched], &mut sent);
+        assert_eq!(ids(&m), [2, 4]);
+        let mut m = layout_of(4);
+        keep_events(&mut m, &[zero; 4], &mut sent);
+        assert_eq!(ids(&m), [4]);
+        let mut m = layout_of(4);
+        keep_events(&mut m, &[zero; 4], &mut sent);
+        assert!(m.cells.is_empty());
+    }
 
     /// The graph's loop without DDS against skin_sim's in-process loop: the only difference is
     /// the messages' float32 skin signals (and ns stamps), so commands agree to that precision.

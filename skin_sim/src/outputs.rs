@@ -12,7 +12,11 @@ use crate::bag::msgs::{
 use crate::bag::BagWriter;
 use crate::plot::{intervals_where, paper000_figure, paper003_figure, Paper000Signals, Paper003Signals};
 use crate::record::{CycleRecord, RunRecord};
-use crate::report::{RunOutput, RunReport};
+use crate::report::{MetricsJson, RunOutput, RunReport, SummaryText};
+
+/// Every product of a run, as `skin_sim run` writes them: `metrics.json`, `summary.txt`,
+/// `figure.png`, `run.mcap`.
+pub const ALL: [&dyn RunOutput; 4] = [&MetricsJson, &SummaryText, &FigurePng, &RunBag];
 
 /// `figure.png`: paper 000's panels (arrangement, ee speed, proximity and contact force, torque)
 /// for a paper 000 scenario, paper 003's force-tracking panels for a force scenario.
@@ -110,7 +114,9 @@ impl RunOutput for RunBag {
             bag.write("/supervisor/arrangement", nanos(first.t_s), &arrangement_msg(first.mode, first.t_s))?;
         }
         let mut switches = r.switches.iter().peekable();
+        let mut safe_stops = 0;
         for c in &r.cycles {
+            safe_stops += u64::from(c.fault.is_some());
             let ns = nanos(c.t_s);
             let header = Header { stamp: Time::from_nanos(ns), frame_id: String::new() };
             bag.write("/clock", ns, &Clock { clock: header.stamp })?;
@@ -142,6 +148,9 @@ impl RunOutput for RunBag {
                 torque_norm: c.torque_norm,
                 goal_error: if s.goal_error_m.is_nan() { -1.0 } else { s.goal_error_m },
                 tasks: Vec::new(),
+                // in process every cycle runs on fresh inputs, no input is ever bad
+                safe_stop_cycles: safe_stops,
+                ..Default::default()
             };
             bag.write("/controller/state", ns, &state)?;
             while let Some(sw) = switches.next_if(|sw| sw.t_s <= c.t_s) {

@@ -1,11 +1,20 @@
 //! One closed-loop run from start to report: load the scene (with run overrides), build the loop,
-//! run it, compute the metrics and the outcome checks.
+//! run it, compute the metrics and the outcome checks. [`ExternalRun`]: the same report for a
+//! run whose controller is outside this process (the ROS graph).
 
 use std::path::PathBuf;
+use std::time::Instant;
+
+use skin_core::controller::ControllerConfig;
+use skin_core::supervisor::{Mode, SupervisorInput};
 
 use crate::closed_loop::{ClosedLoop, LoopError};
+use crate::hand_force::HandForceMap;
+use crate::interaction::Interactions;
 use crate::metrics::{self, Limits};
 use crate::outcome;
+use crate::probe::ContactProbe;
+use crate::record::{CycleRecord, RunRecord, Switch};
 use crate::report::RunReport;
 use crate::scenario::{self, ForceTargets, Scenario};
 use crate::scene::{RunOverrides, Scene};
@@ -76,15 +85,132 @@ impl RunTarget {
     pub fn run_scene(&self, scene: Scene, progress: impl FnMut(f64)) -> Result<RunReport, LoopError> {
         let duration = scene.spec.duration_s;
         let closed_loop = ClosedLoop::new(scene.clone(), &self.controller)?;
-        let thresholds = closed_loop.controller().config().supervisor.thresholds;
-        let limits = Limits {
-            eps_c_n: thresholds.contact_force_n,
-            goal_tolerance_m: thresholds.goal_tolerance_m,
-        };
-        let mut record = closed_loop.run(duration, progress);
+        let limits = limits_of(closed_loop.controller().config());
+        let record = closed_loop.run(duration, progress);
+        Ok(self.report(record, &scene, limits))
+    }
+
+    /// The report of `record`, a run of `scene` (named after this target): metrics and checks.
+    pub fn report(&self, mut record: RunRecord, scene: &Scene, limits: Limits) -> RunReport {
         record.name = self.name.clone();
-        let metrics = metrics::compute(&record, &scene, limits);
+        let metrics = metrics::compute(&record, scene, limits);
         let checks = outcome::checks(&metrics, self.force_targets);
-        Ok(RunReport { record, metrics, checks })
+        RunReport { record, metrics, checks }
+    }
+}
+
+/// The supervisor thresholds the metrics compare with.
+fn limits_of(config: &ControllerConfig) -> Limits {
+    let thresholds = config.supervisor.thresholds;
+    Limits {
+        eps_c_n: thresholds.contact_force_n,
+        goal_tolerance_m: thresholds.goal_tolerance_m,
+    }
+}
+
+/// One cycle of a controller outside this process, as it published it (the ROS graph's
+/// `/controller/state` and commands).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Decision {
+    /// Commanded arm joint velocities, the world's arm joint order.
+    pub joint_velocities: Vec<f64>,
+    /// Commanded base twist `(vx, vy, wz)`, base frame.
+    pub base_twist: [f64; 3],
+    /// Active arrangement.
+    pub mode: Mode,
+    /// Blend factor `χ`.
+    pub blend: f64,
+    /// Fusion weight of the skin (the graph publishes the arrangement's target).
+    pub fusion_weight: f64,
+    /// The supervisor's signals.
+    pub signals: SupervisorInput,
+    /// `‖τ*‖` \[N m\].
+    pub torque_norm: f64,
+    /// The fault text when the cycle was a safe-stop step.
+    pub fault: Option<String>,
+    /// Wall-clock time the cycle took as its caller saw it \[µs\].
+    pub compute_us: f64,
+}
+
+/// A run of a target whose controller runs elsewhere (the ROS graph in lockstep): the caller
+/// steps its own world and, per control period, gives the world before the step and the
+/// controller's [`Decision`]; the physical measurements (contact forces, interactions) are taken
+/// here as [`ClosedLoop`] takes them, and [`ExternalRun::finish`] gives the report that
+/// [`RunTarget::run`] gives, from the same metrics and checks.
+pub struct ExternalRun {
+    target: RunTarget,
+    scene: Scene,
+    limits: Limits,
+    probe: ContactProbe,
+    interactions: Interactions,
+    hand: Option<HandForceMap>,
+    record: RunRecord,
+    started: Instant,
+}
+
+impl ExternalRun {
+    /// Starts the record of `target` run on `scene` in `world` (a world of that scene). The
+    /// controller setup is checked against the scene as the in-process loop checks it, and the
+    /// record has its header.
+    pub fn new(target: &RunTarget, scene: Scene, world: &crate::world::World) -> Result<Self, LoopError> {
+        let in_process = ClosedLoop::new(scene.clone(), &target.controller)?;
+        let config = in_process.controller().config();
+        let ee = config.model.frame_index(&config.setup.end_effector).expect("checked by Controller::new");
+        Ok(ExternalRun {
+            limits: limits_of(config),
+            probe: ContactProbe::new(world, ee),
+            interactions: Interactions::new(&scene, config.tasks.base_avoidance),
+            hand: HandForceMap::new(config),
+            record: in_process.record().clone(),
+            target: target.clone(),
+            scene,
+            started: Instant::now(),
+        })
+    }
+
+    /// Records one control period: `world` at the state the controller answered (before the
+    /// step), `force_n` the force reference the scene gave it \[N\] (None: none), `decision`
+    /// its answer.
+    pub fn cycle(&mut self, world: &crate::world::World, force_n: Option<f64>, decision: Decision) {
+        let t_s = world.time();
+        if let Some(last) = self.record.cycles.last().filter(|c| c.mode != decision.mode) {
+            self.record.switches.push(Switch { t_s, from: last.mode, to: decision.mode });
+        }
+        let forces = self.probe.measure(world);
+        // As the schedule gives it: a reference only with a hand to map it to.
+        let (force_reference_n, force_reference_signal) = match (force_n, &self.hand) {
+            (Some(f), Some(map)) => (f, map.signal(f)),
+            _ => (f64::NAN, f64::NAN),
+        };
+        self.record.cycles.push(CycleRecord {
+            t_s,
+            q: world.q().to_vec(),
+            qd: world.qd().to_vec(),
+            joint_velocities: decision.joint_velocities,
+            base_twist: decision.base_twist,
+            mode: decision.mode,
+            blend: decision.blend,
+            fusion_weight: decision.fusion_weight,
+            signals: decision.signals,
+            torque_norm: decision.torque_norm,
+            hand_force_n: forces.hand_n,
+            link_force_n: forces.max_link_n,
+            force_reference_n,
+            force_reference_signal,
+            interaction: self.interactions.active(t_s, world.q()),
+            fault: decision.fault,
+            compute_us: decision.compute_us,
+        });
+    }
+
+    /// The cycles recorded so far.
+    pub fn cycles(&self) -> usize {
+        self.record.cycles.len()
+    }
+
+    /// The report; the wall time runs from [`ExternalRun::new`].
+    pub fn finish(mut self) -> RunReport {
+        self.record.wall_time_s = self.started.elapsed().as_secs_f64();
+        self.target.report(self.record, &self.scene, self.limits)
     }
 }

@@ -1,11 +1,14 @@
 //! `skin_stack`: the nodes composed in one process, one r2r node each, one executor (a single
 //! thread): task_controller, priority_supervisor and, with --scene, mujoco_sim. For the demo and
 //! the tests; each node behaves as its own binary does.
+use std::path::PathBuf;
+use std::process::ExitCode;
+
 use anyhow::{Context as _, Result};
 use clap::Parser;
 use futures::executor::LocalPool;
 use r2r::{Parameter, ParameterValue};
-use skin_control::nodes::{self, mujoco_sim, priority_supervisor, task_controller};
+use skin_control::nodes::{self, mujoco_sim, priority_supervisor, task_controller, Pass};
 use skin_control::shutdown;
 
 /// The skin control graph in one process: task_controller + priority_supervisor (+ mujoco_sim
@@ -14,14 +17,18 @@ use skin_control::shutdown;
 ///
 /// With --scene and --lockstep the controller runs with trigger:=inputs at the scene's control
 /// rate; --internal-supervisor makes it decide the arrangement in its own cycle (the in-process
-/// loop's behaviour, reproducible) while priority_supervisor still runs and publishes.
+/// loop's behaviour, reproducible) while priority_supervisor still runs and publishes. --out
+/// writes the run's metrics.json, summary.txt, figure.png and run.mcap as `skin_sim run` does.
+///
+/// Exit code: 0, 1 when an outcome check of --out failed, 2 when the run failed.
 #[derive(Parser)]
 #[command(
     version,
-    after_help = "Examples:\n  skin_stack --setup config/controller/planar7.yaml --scene intentional_contact --lockstep --internal-supervisor --duration 4\n  skin_stack --ros-args --params-file config/ros/task_controller.yaml"
+    after_help = "Examples:\n  skin_stack --scene intentional_contact --lockstep --internal-supervisor --out out/intentional_contact\n  skin_stack --setup config/controller/planar7.yaml --scene intentional_contact --lockstep --internal-supervisor --duration 4\n  skin_stack --ros-args --params-file config/ros/task_controller.yaml"
 )]
 struct Args {
-    /// Controller setup file for the controller and the supervisor [default: config/controller/tomm.yaml].
+    /// Controller setup file for the controller and the supervisor [default: the scenario's
+    /// with --scene, else config/controller/tomm.yaml].
     #[arg(long, value_name = "FILE")]
     setup: Option<String>,
     /// Also run mujoco_sim on this scene (scenario name or scene file).
@@ -38,15 +45,25 @@ struct Args {
     duration: Option<f64>,
     /// mujoco_sim: write the applied commands per period (JSON) here at the end.
     #[arg(long, value_name = "FILE")]
-    record: Option<std::path::PathBuf>,
+    record: Option<PathBuf>,
+    /// mujoco_sim: write the run's outputs here (needs --lockstep).
+    #[arg(long, value_name = "DIR", requires = "lockstep")]
+    out: Option<PathBuf>,
 }
 
 fn set(node: &r2r::Node, key: &str, value: ParameterValue) {
     node.params.lock().unwrap().insert(key.to_string(), Parameter::new(value));
 }
 
-fn main() -> Result<()> {
-    let args = Args::parse_from(nodes::cli_args());
+fn main() -> ExitCode {
+    nodes::exit_code("skin_stack", run())
+}
+
+fn run() -> Result<Option<bool>> {
+    let mut args = Args::parse_from(nodes::cli_args());
+    if args.setup.is_none() {
+        args.setup = args.scene.as_deref().and_then(mujoco_sim::scenario_setup).map(|p| p.display().to_string());
+    }
     shutdown::install().context("installing the SIGINT/SIGTERM handler")?;
     let ctx = r2r::Context::create()?;
     let mut pool = LocalPool::new();
@@ -66,6 +83,8 @@ fn main() -> Result<()> {
                 arm_namespaces: vec![],
                 arm_prefixes: vec![],
                 record: args.record.clone(),
+                out: args.out.clone(),
+                controller: args.setup.as_ref().map(PathBuf::from),
             };
             Some(mujoco_sim::start(node, &spawner, options)?)
         }
@@ -90,26 +109,26 @@ fn main() -> Result<()> {
         if let Some(n) = sim_node.as_mut() {
             all.push(n);
         }
-        nodes::spin(&mut all, &mut pool, || {
+        nodes::spin_passes(&mut all, &mut pool, || {
+            let cycles = tc.counts().0;
             tc.poll();
+            let controlled = if tc.counts().0 == cycles { Pass::Idle } else { Pass::Busy };
             match sim.as_mut().map(|s| s.poll()) {
-                Some(Ok(done)) => done,
+                Some(Ok(Pass::Idle)) | None => controlled,
+                Some(Ok(pass)) => pass,
                 Some(Err(e)) => {
                     failure = Some(e);
-                    true
+                    Pass::Done
                 }
-                None => false,
             }
         });
     }
     tc.stop();
     sup.stop();
-    if let Some(s) = &sim {
-        s.stop()?;
-    }
+    let outcome = sim.map(|s| s.stop()).transpose()?.flatten();
     tc_node.spin_once(std::time::Duration::from_millis(50));
     match failure {
         Some(e) => Err(e.context("mujoco_sim")),
-        None => Ok(()),
+        None => Ok(outcome),
     }
 }

@@ -105,6 +105,19 @@ impl std::fmt::Display for Timing {
     }
 }
 
+/// A binary's exit code (skin_sim's convention): 0, 1 when an outcome check failed
+/// (`Some(false)`), 2 when the run failed (the error is printed).
+pub fn exit_code(binary: &str, run: Result<Option<bool>>) -> std::process::ExitCode {
+    match run {
+        Ok(Some(false)) => std::process::ExitCode::from(1),
+        Ok(_) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{binary}: {e:#}");
+            std::process::ExitCode::from(2)
+        }
+    }
+}
+
 /// The arguments before `--ros-args` (what clap parses; rcl parses the rest).
 pub fn cli_args() -> impl Iterator<Item = String> {
     std::env::args().take_while(|a| a != "--ros-args")
@@ -115,10 +128,33 @@ pub fn cli_args() -> impl Iterator<Item = String> {
 /// polled: the first waits at most 100 us, the others are only checked, so a message to any
 /// node waits at most ~100 us for its turn.
 pub fn spin(nodes: &mut [&mut r2r::Node], pool: &mut futures::executor::LocalPool, mut done: impl FnMut() -> bool) {
+    spin_passes(nodes, pool, || if done() { Pass::Done } else { Pass::Idle });
+}
+
+/// What the poll of one pass of [`spin_passes`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pass {
+    /// Nothing sent: the next pass may wait for traffic.
+    Idle,
+    /// Something was published: a node of this process may have a message already.
+    Busy,
+    /// Stop spinning.
+    Done,
+}
+
+/// [`spin`] with a poll that says whether it published: after a busy pass no node waits (a
+/// message from one composed node to another is delivered at once, and waiting in the first
+/// node's wait set would hold it up to 100 us).
+pub fn spin_passes(nodes: &mut [&mut r2r::Node], pool: &mut futures::executor::LocalPool, mut poll: impl FnMut() -> Pass) {
     let wait = if nodes.len() > 1 { Duration::from_micros(100) } else { Duration::from_millis(5) };
-    while !crate::shutdown::requested() && !done() {
+    while !crate::shutdown::requested() {
+        let first = match poll() {
+            Pass::Done => return,
+            Pass::Busy => Duration::ZERO,
+            Pass::Idle => wait,
+        };
         for (k, node) in nodes.iter_mut().enumerate() {
-            node.spin_once(if k == 0 { wait } else { Duration::ZERO });
+            node.spin_once(if k == 0 { first } else { Duration::ZERO });
         }
         pool.run_until_stalled();
     }

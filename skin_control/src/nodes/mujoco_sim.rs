@@ -10,6 +10,11 @@
 //!   already answered).
 //! - **real time**: steps one period every `period / realtime_factor` of wall time with the
 //!   latest commands, publishing the state after each.
+//!
+//! With `--out DIR` (lockstep) a period also waits for the controller's `/controller/state`
+//! answering it, and the run is recorded as `skin_sim run` records it
+//! ([`skin_sim::runner::ExternalRun`]: the world, the commands, the published state): the same
+//! report, outcome checks and files (`skin_sim::outputs::ALL`) are written at the end.
 use std::cell::RefCell;
 use std::path::PathBuf;
 use std::rc::Rc;
@@ -23,12 +28,15 @@ use r2r::geometry_msgs::msg::{PoseStamped, Twist};
 use r2r::nav_msgs::msg::Odometry;
 use r2r::rosgraph_msgs::msg::Clock;
 use r2r::sensor_msgs::msg::{JointState, LaserScan};
-use r2r::skin_msgs::msg::SkinCellArray;
+use r2r::skin_msgs::msg::{Arrangement, ControllerState, SkinCellArray};
 use r2r::std_msgs::msg::{Float64, Float64MultiArray};
+use skin_sim::runner::{ExternalRun, RunTarget};
 
 use super::topics::*;
+use super::Pass;
+use crate::convert::robot::time_msg;
 use crate::qos;
-use crate::sim_bridge::{AppliedCommand, SimBridge, SimMessages};
+use crate::sim_bridge::{decision, AppliedCommand, SimBridge, SimMessages};
 use crate::task_controller::ArmsParams;
 
 /// Node name.
@@ -61,12 +69,25 @@ pub struct Options {
     /// Write the applied commands per period (JSON) here at the end.
     #[arg(long, value_name = "FILE")]
     pub record: Option<PathBuf>,
+    /// Lockstep: record the run as `skin_sim run` does and write its metrics.json, summary.txt,
+    /// figure.png and run.mcap here at the end (exit code 1 when an outcome check fails).
+    #[arg(long, value_name = "DIR", requires = "lockstep")]
+    pub out: Option<PathBuf>,
+    /// With --out: the controller setup the run is judged with (its thresholds, hand, end
+    /// effector) [default: the scenario's].
+    #[arg(long, value_name = "FILE")]
+    pub controller: Option<PathBuf>,
 }
 
 /// The scene file of a scenario name or a path.
 pub fn scene_file(arg: &str) -> Result<PathBuf> {
-    let target = skin_sim::runner::RunTarget::resolve(arg, Some(PathBuf::new())).map_err(|e| anyhow::anyhow!("--scene: {e}"))?;
+    let target = RunTarget::resolve(arg, Some(PathBuf::new())).map_err(|e| anyhow::anyhow!("--scene: {e}"))?;
     Ok(target.scene)
+}
+
+/// The controller setup of a scenario (None: a scene file that is not a scenario's).
+pub fn scenario_setup(arg: &str) -> Option<PathBuf> {
+    RunTarget::resolve(arg, None).ok().map(|t| t.controller)
 }
 
 struct Pubs {
@@ -82,7 +103,19 @@ struct Pubs {
 struct Inbox {
     arms: Vec<Option<Float64MultiArray>>,
     twist: Option<Twist>,
+    /// `--out`: the controller's state of the period and the arrangement's fusion weight.
+    state: Option<ControllerState>,
+    fusion_weight: f64,
     errors: u64,
+}
+
+/// `--out`: the run's record and where it goes.
+struct Recorder {
+    run: ExternalRun,
+    dir: PathBuf,
+    /// The controller state answering the current period, once taken from the inbox.
+    state: Option<ControllerState>,
+    safe_stops: u64,
 }
 
 /// The running node; [`SimHandle::poll`] drives it from the spin loop.
@@ -100,6 +133,8 @@ pub struct SimHandle {
     periods: u64,
     resends: u64,
     last_force: Option<f64>,
+    recorder: Option<Recorder>,
+    progress_s: f64,
 }
 
 /// The controller's sensor inputs of one period, joint states last: the controller's input set is
@@ -142,12 +177,22 @@ impl SimHandle {
     }
 
     /// Takes the commands in the inbox into the bridge; in lockstep only when every topic has a
-    /// new one. Returns whether they were taken.
+    /// new one (and, recording, the controller state of this period has come). Returns whether
+    /// they were taken.
     fn take_commands(&mut self, all_needed: bool) -> bool {
         let mut inbox = self.inbox.borrow_mut();
-        let complete = inbox.arms.iter().all(Option::is_some) && (!self.bridge.has_base() || inbox.twist.is_some());
+        let stamp = time_msg(self.bridge.world().time());
+        if inbox.state.as_ref().is_some_and(|s| s.header.stamp != stamp) {
+            inbox.state = None; // an answer to an earlier period (a resend)
+        }
+        let complete = inbox.arms.iter().all(Option::is_some)
+            && (!self.bridge.has_base() || inbox.twist.is_some())
+            && (self.recorder.is_none() || inbox.state.is_some());
         if all_needed && !complete {
             return false;
+        }
+        if let Some(r) = &mut self.recorder {
+            r.state = inbox.state.take();
         }
         for k in 0..inbox.arms.len() {
             if let Some(m) = inbox.arms[k].take() {
@@ -174,32 +219,58 @@ impl SimHandle {
         let mut inbox = self.inbox.borrow_mut();
         inbox.arms.iter_mut().for_each(|a| *a = None);
         inbox.twist = None;
+        inbox.state = None;
     }
 
-    fn advance(&mut self) {
-        self.record.push(self.bridge.applied());
+    /// Records the period (with `--out`), applies the commands and steps.
+    fn advance(&mut self) -> Result<()> {
+        let applied = self.bridge.applied();
+        if let Some(r) = &mut self.recorder {
+            let state = r.state.take().context("lockstep: no controller state for the period")?;
+            let round_trip_us = self.sent_at.map_or(0.0, |s| s.elapsed().as_secs_f64() * 1e6);
+            let fusion_weight = self.inbox.borrow().fusion_weight;
+            let d = decision(&state, &applied, r.safe_stops, fusion_weight, round_trip_us).map_err(anyhow::Error::msg)?;
+            r.safe_stops = state.safe_stop_cycles;
+            r.run.cycle(self.bridge.world(), self.last_force, d);
+        }
+        self.record.push(applied);
         self.bridge.step_period();
         self.periods += 1;
+        self.log_progress();
+        Ok(())
     }
 
-    /// One pass of the spin loop; returns true when the run is over.
-    pub fn poll(&mut self) -> Result<bool> {
+    /// A progress line at every tenth of the run.
+    fn log_progress(&mut self) {
+        let t = self.bridge.world().time();
+        if t + 1e-9 < self.progress_s {
+            return;
+        }
+        self.progress_s += self.end_s / 10.0;
+        let rtf = t / self.started.elapsed().as_secs_f64().max(1e-9);
+        r2r::log_info!(&self.logger, "t = {t:.1} / {:.1} s (real-time factor {rtf:.2})", self.end_s);
+    }
+
+    /// One pass of the spin loop: [`Pass::Busy`] when it published, [`Pass::Done`] when the run
+    /// is over.
+    pub fn poll(&mut self) -> Result<Pass> {
         let t = self.bridge.world().time();
         if self.options.lockstep {
             let Some(sent) = self.sent_at else {
                 self.clear_inbox();
                 self.publish_state()?;
                 self.sent_at = Some(Instant::now());
-                return Ok(false);
+                return Ok(Pass::Busy);
             };
             if self.take_commands(true) {
-                self.advance();
+                self.advance()?;
                 if self.bridge.world().time() >= self.end_s - 1e-9 {
-                    return Ok(true);
+                    return Ok(Pass::Done);
                 }
                 self.clear_inbox();
                 self.publish_state()?;
                 self.sent_at = Some(Instant::now());
+                Ok(Pass::Busy)
             } else if sent.elapsed() > Duration::from_secs_f64(self.options.resend) {
                 self.resends += 1;
                 if self.resends == 1 {
@@ -207,27 +278,30 @@ impl SimHandle {
                 }
                 self.republish()?;
                 self.sent_at = Some(Instant::now());
+                Ok(Pass::Busy)
+            } else {
+                Ok(Pass::Idle)
             }
-            Ok(false)
         } else {
             let now = Instant::now();
             if now < self.next_tick {
-                return Ok(false);
+                return Ok(Pass::Idle);
             }
             self.take_commands(false);
-            self.advance();
+            self.advance()?;
             self.publish_state()?;
             let period = Duration::from_secs_f64(self.bridge.period_s() / self.options.realtime_factor);
             self.next_tick += period;
             if self.next_tick + period * 10 < now {
                 self.next_tick = now; // too far behind: do not try to catch up in a burst
             }
-            Ok(self.bridge.world().time() >= self.end_s - 1e-9)
+            Ok(if self.bridge.world().time() >= self.end_s - 1e-9 { Pass::Done } else { Pass::Busy })
         }
     }
 
-    /// Writes the record (if asked) and logs the summary.
-    pub fn stop(&self) -> Result<()> {
+    /// Writes the record (if asked) and logs the summary; with `--out` writes the run's files,
+    /// prints its summary and returns whether every outcome check passed.
+    pub fn stop(self) -> Result<Option<bool>> {
         let wall = self.started.elapsed().as_secs_f64();
         let sim = self.bridge.world().time();
         r2r::log_info!(
@@ -247,8 +321,19 @@ impl SimHandle {
             });
             std::fs::write(path, serde_json::to_string(&json)?).with_context(|| format!("--record {}", path.display()))?;
         }
-        Ok(())
+        self.recorder.map(write_report).transpose()
     }
+}
+
+/// The report of a recorded run into its directory, its summary on stdout.
+fn write_report(r: Recorder) -> Result<bool> {
+    anyhow::ensure!(r.run.cycles() > 0, "--out {}: no control period was completed", r.dir.display());
+    let report = r.run.finish();
+    let files = skin_sim::report::write_all(&report, &r.dir, &skin_sim::outputs::ALL)?;
+    print!("{}", report.summary());
+    let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
+    println!("  wrote {}", names.join(", "));
+    Ok(report.passed())
 }
 
 /// Creates the world, the node's entities, and spawns the command subscriptions.
@@ -264,7 +349,8 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
     if !(options.realtime_factor.is_finite() && options.realtime_factor > 0.0) {
         anyhow::bail!("--realtime-factor {}: must be > 0", options.realtime_factor);
     }
-    let bridge = SimBridge::new(scene, &options.arm_namespaces, &options.arm_prefixes).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    let bridge = SimBridge::new(scene.clone(), &options.arm_namespaces, &options.arm_prefixes).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    let recorder = options.out.as_ref().map(|dir| start_recorder(&options, scene, &bridge, dir)).transpose()?;
     let end_s = options.duration.unwrap_or(bridge.duration_s());
     let pubs = Pubs {
         clock: node.create_publisher(CLOCK, qos::stream())?,
@@ -275,7 +361,7 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
         goal: node.create_publisher(GOAL, qos::latched())?,
         force: node.create_publisher(FORCE_REFERENCE, qos::latched())?,
     };
-    let inbox = Rc::new(RefCell::new(Inbox { arms: vec![None; bridge.arms().len()], twist: None, errors: 0 }));
+    let inbox = Rc::new(RefCell::new(Inbox { arms: vec![None; bridge.arms().len()], twist: None, state: None, fusion_weight: f64::NAN, errors: 0 }));
     for (k, arm) in bridge.arms().iter().enumerate() {
         let mut sub = node.subscribe::<Float64MultiArray>(&arm.topic, qos::stream())?;
         let inbox = inbox.clone();
@@ -293,6 +379,9 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
                 inbox.borrow_mut().twist = Some(m);
             }
         })?;
+    }
+    if recorder.is_some() {
+        subscribe_controller(node, spawner, &inbox)?;
     }
     let topics: Vec<&str> = bridge.arms().iter().map(|a| a.topic.as_str()).collect();
     r2r::log_info!(
@@ -317,6 +406,35 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
         periods: 0,
         resends: 0,
         last_force: None,
+        recorder,
+        progress_s: end_s / 10.0,
         options,
     })
+}
+
+/// `--out`: the run's record, judged with the scenario's (or `--controller`) setup.
+fn start_recorder(options: &Options, scene: skin_sim::scene::Scene, bridge: &SimBridge, dir: &std::path::Path) -> Result<Recorder> {
+    let target = RunTarget::resolve(&options.scene, options.controller.clone()).map_err(|e| anyhow::anyhow!("--scene: {e}"))?;
+    let run = ExternalRun::new(&target, scene, bridge.world()).with_context(|| format!("--out: {}", target.controller.display()))?;
+    Ok(Recorder { run, dir: dir.to_path_buf(), state: None, safe_stops: 0 })
+}
+
+/// `--out`: `/controller/state` (the period's answer) and `/supervisor/arrangement` (its
+/// fusion weight) into the inbox.
+fn subscribe_controller(node: &mut r2r::Node, spawner: &LocalSpawner, inbox: &Rc<RefCell<Inbox>>) -> Result<()> {
+    let mut states = node.subscribe::<ControllerState>(CONTROLLER_STATE, qos::stream())?;
+    let states_inbox = inbox.clone();
+    spawner.spawn_local(async move {
+        while let Some(m) = states.next().await {
+            states_inbox.borrow_mut().state = Some(m);
+        }
+    })?;
+    let mut arrangements = node.subscribe::<Arrangement>(ARRANGEMENT, qos::latched())?;
+    let inbox = inbox.clone();
+    spawner.spawn_local(async move {
+        while let Some(m) = arrangements.next().await {
+            inbox.borrow_mut().fusion_weight = m.fusion_weight;
+        }
+    })?;
+    Ok(())
 }

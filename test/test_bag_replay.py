@@ -130,7 +130,9 @@ def test_replayed_inputs_reproduce_the_recorded_outputs(spawn, tmp_path, store, 
     recorded = tmp_path / "scenario.mcap"
     nodes = start_nodes(spawn)
     rec = start_recorder(spawn, recorded, {**INPUTS, **OUTPUTS})
-    sim = spawn(binary("mujoco_sim"), "--scene", SCENE, "--lockstep", "--duration", str(DURATION))
+    # the first state must reach the recorder too (and the cells the aggregator)
+    sim = spawn(binary("mujoco_sim"), "--scene", SCENE, "--lockstep", "--duration", str(DURATION),
+                "--wait-topic-subscribers", "/joint_states=2", "/base/odom=2", "/scan=2", "/skin/cells=3")
     out, _ = sim.communicate(timeout=120)
     assert sim.returncode == 0 and f"after {int(DURATION * RATE)} periods" in out, out
     (rec_out,) = stop([rec])

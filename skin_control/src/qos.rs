@@ -7,7 +7,8 @@ pub fn stream() -> QosProfile {
     QosProfile::default().reliable().keep_last(10)
 }
 
-/// Inputs whose every sample matters (the supervisor's dwell timers count controller states): a
+/// Inputs whose every sample matters (the supervisor's dwell timers count controller states;
+/// `/skin/cells` is event driven, a lost message would lose its cells' changes): a
 /// deep reader history, so a node that is descheduled for a while (lockstep simulation runs the
 /// graph several times faster than real time) catches up instead of losing samples; r2r takes
 /// one sample per spin, so the reader history is the only buffer.

@@ -177,6 +177,12 @@ impl SimBridge {
         self.world.scene().spec.duration_s
     }
 
+    /// The messages [`SimBridge::messages`] made last, unchanged: a resend must repeat them
+    /// exactly (making them again would strip the event-driven cells already sent).
+    pub fn last_messages(&self) -> &SimMessages {
+        &self.msgs
+    }
+
     /// The messages of the current state (the scene's goal only in the period it starts).
     pub fn messages(&mut self) -> &SimMessages {
         let w = &self.world;

@@ -60,6 +60,10 @@ pub struct Options {
     /// Lockstep: resend the state after this much wall time without commands [s].
     #[arg(long, default_value_t = 1.0, value_name = "SECONDS")]
     pub resend: f64,
+    /// Lockstep: before the first state, wait (at most 30 s) until TOPIC has N subscribers, e.g.
+    /// `/skin/cells=3` when the controller, the aggregator and a recorder must all get it.
+    #[arg(long, num_args = 1.., value_name = "TOPIC=N", value_parser = crate::rosbag::play::topic_count)]
+    pub wait_topic_subscribers: Vec<(String, usize)>,
     /// Command namespaces, one per arm (default: /left_arm /right_arm for TOMM, else /arm).
     #[arg(long = "arm-namespace", value_name = "NS")]
     pub arm_namespaces: Vec<String>,
@@ -169,9 +173,35 @@ impl SimHandle {
         publish_inputs(&self.pubs, m)
     }
 
+    /// Whether a topic of `--wait-topic-subscribers` still lacks subscribers (false after 30 s,
+    /// with a warning naming them).
+    fn lacking_subscribers(&self) -> Result<bool> {
+        let p = &self.pubs;
+        let mut lacking = Vec::new();
+        for (topic, wanted) in &self.options.wait_topic_subscribers {
+            let n = match topic.as_str() {
+                JOINT_STATES => p.joints.get_inter_process_subscription_count(),
+                CELLS => p.cells.get_inter_process_subscription_count(),
+                ODOM => p.odom.get_inter_process_subscription_count(),
+                SCAN => p.scan.get_inter_process_subscription_count(),
+                CLOCK => p.clock.get_inter_process_subscription_count(),
+                _ => anyhow::bail!("--wait-topic-subscribers: `{topic}` is not an input topic ({JOINT_STATES}, {CELLS}, {ODOM}, {SCAN}, {CLOCK})"),
+            }
+            .with_context(|| format!("{topic}: subscription count"))?;
+            if n < *wanted {
+                lacking.push(format!("{topic} ({n} of {wanted})"));
+            }
+        }
+        if !lacking.is_empty() && self.started.elapsed() > Duration::from_secs(30) {
+            r2r::log_warn!(&self.logger, "after 30 s too few subscribers on {}: starting anyway", lacking.join(", "));
+            return Ok(false);
+        }
+        Ok(!lacking.is_empty())
+    }
+
     fn republish(&mut self) -> Result<()> {
-        // Same state, same stamps (the goal only if it is the period's; force unchanged).
-        let m = self.bridge.messages();
+        // The same messages again (the goal only if it is the period's; force unchanged).
+        let m = self.bridge.last_messages();
         self.pubs.clock.publish(&m.clock).context(CLOCK)?;
         publish_inputs(&self.pubs, m)
     }
@@ -257,6 +287,9 @@ impl SimHandle {
         let t = self.bridge.world().time();
         if self.options.lockstep {
             let Some(sent) = self.sent_at else {
+                if self.lacking_subscribers()? {
+                    return Ok(Pass::Idle);
+                }
                 self.clear_inbox();
                 self.publish_state()?;
                 self.sent_at = Some(Instant::now());

@@ -237,7 +237,7 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
             s.refused(result);
         })?;
     }
-    let cells = node.subscribe::<SkinCellArray>(CELLS, qos::stream())?;
+    let cells = node.subscribe::<SkinCellArray>(CELLS, qos::every_sample())?;
     spawn_sub(spawner, cells, &shared, |s, msg| {
         let (now, log) = (s.now(), s.logger.clone());
         let result = s.tc.on_cells(&msg, now, |i| {

@@ -211,7 +211,7 @@ fn publish_clock(clock: Option<&r2r::Publisher<Clock>>, bag: &RawBag, i: usize) 
 }
 
 /// `TOPIC=N` of `--wait-topic-subscribers`.
-fn topic_count(s: &str) -> Result<(String, usize), String> {
+pub(crate) fn topic_count(s: &str) -> Result<(String, usize), String> {
     let (topic, n) = s.split_once('=').ok_or_else(|| format!("`{s}`: expected TOPIC=N"))?;
     let n = n.parse().map_err(|e| format!("`{s}`: count `{n}`: {e}"))?;
     Ok((topic.to_string(), n))

@@ -251,13 +251,9 @@ mod tests {
     use super::*;
     use crate::skin::layout::SkinLayout;
 
+    /// Two patches on links `a` and `b`, cells 10, 11 (patch 7) and 20 (patch 3).
     fn layout() -> ResolvedLayout {
-        let text =
-            "patches:\n  - {id: 7, link: a}\n  - {id: 3, link: b, xyz: [0, 0, 1]}\ncells:\n  \
-                    - {id: 10, patch: 7, position: [0.1, 0, 0], normal: [1, 0, 0]}\n  \
-                    - {id: 11, patch: 7, position: [0, 0.1, 0], normal: [0, 1, 0]}\n  \
-                    - {id: 20, patch: 3, position: [0, 0, 0.1], normal: [0, 0, 1]}\n";
-        SkinLayout::from_yaml_str(text, "t.yaml")
+        SkinLayout::from_yaml_str(include_str!("testdata/two_patches.yaml"), "two_patches.yaml")
             .unwrap()
             .resolve_with(|l| Some(if l == "a" { 1 } else { 2 }))
             .unwrap()

@@ -224,9 +224,10 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
 
     let js = node.subscribe::<JointState>(JOINT_STATES, qos::stream())?;
     spawn_sub(spawner, js, &shared, |s, msg| {
-        let (now, log) = (s.now(), s.logger.clone());
-        let result = s.tc.on_joint_states(&msg, now, |i| {
-            r2r::log_warn!(&log, "{JOINT_STATES}: {i} (further ones are counted in /controller/state)");
+        let now = s.now();
+        let Shared { tc, logger, .. } = &mut *s;
+        let result = tc.on_joint_states(&msg, now, |i| {
+            r2r::log_warn!(logger, "{JOINT_STATES}: {i} (further ones are counted in /controller/state)");
         });
         s.refused(result);
     })?;
@@ -239,9 +240,10 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     }
     let cells = node.subscribe::<SkinCellArray>(CELLS, qos::every_sample())?;
     spawn_sub(spawner, cells, &shared, |s, msg| {
-        let (now, log) = (s.now(), s.logger.clone());
-        let result = s.tc.on_cells(&msg, now, |i| {
-            r2r::log_warn!(&log, "{CELLS}: {i} (further ones are counted in /controller/state)");
+        let now = s.now();
+        let Shared { tc, logger, .. } = &mut *s;
+        let result = tc.on_cells(&msg, now, |i| {
+            r2r::log_warn!(logger, "{CELLS}: {i} (further ones are counted in /controller/state)");
         });
         s.refused(result);
     })?;

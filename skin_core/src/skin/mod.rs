@@ -17,6 +17,7 @@ pub mod cell_forces;
 pub mod characteristic;
 pub mod generate;
 pub mod layout;
+pub mod live;
 pub mod params;
 pub mod repulsion;
 pub mod resolved;

@@ -9,9 +9,10 @@ use std::path::PathBuf;
 use nalgebra::{DMatrix, DVector, Matrix6xX, Vector3, Vector6};
 use skin_core::hierarchy::*;
 use skin_core::model::*;
-use skin_core::skin::aggregate::{aggregate_patches, PatchWrench};
+use skin_core::skin::aggregate::{aggregate_live_patches, aggregate_patches, PatchWrench};
 use skin_core::skin::cell_forces::{cell_contact_forces, cell_repulsion_forces, PointForce};
 use skin_core::skin::layout::SkinLayout;
+use skin_core::skin::live::LiveCells;
 use skin_core::skin::params::SkinParams;
 use skin_core::skin::signals::CellReading;
 use skin_core::skin::torques::{patch_wrenches_to_torques, point_forces_to_torques};
@@ -345,20 +346,22 @@ fn tasks_do_not_allocate_after_setup() {
     ];
     let mut wrenches: Vec<PatchWrench> = Vec::with_capacity(layout.patches().len());
     let mut poses = Vec::with_capacity(layout.patches().len());
+    let mut live = LiveCells::with_capacity(n);
     let goal_x = Vector3::new(0.5, -0.3, 1.0);
     let goal_r = UnitQuaternion::identity();
 
     let mut cycle = |data: &mut ModelData| {
         update_kinematics(&model, data, &q, &qd).unwrap();
-        aggregate_patches(&layout, &readings, &skin.fusion, &mut wrenches).unwrap();
+        live.collect(&readings);
+        aggregate_live_patches(&layout, &live, &skin.fusion, &mut wrenches).unwrap();
         patch_poses_world(&layout, |f| data.frame_pose(f), &mut poses);
         let h_f = sum_patch_forces_in_frame(data.frame_pose(hand), &poses, &wrenches, |j| j < 6);
         let gamma = patch_wrench_world(&poses[5], &wrenches[5]).moment;
         let [l0, l1, l2, l3, l4, l5, l6, l7] = &mut levels;
         goal.update(&model, data, &goal_x, l0).unwrap();
         orient.update(&model, data, &goal_r, l1).unwrap();
-        avoid.update(&model, data, &layout, &readings, &skin.proximity, 0.08, l2).unwrap();
-        contact.update(&model, data, &layout, &readings, &skin.force, &skin.fusion, l3).unwrap();
+        avoid.update(&model, data, &layout, &live, &skin.proximity, 0.08, l2).unwrap();
+        contact.update(&model, data, &layout, &live, &skin.force, &skin.fusion, l3).unwrap();
         hand_task.update(&model, data, HandMeasurement::Force { fused_signal: 0.1 }, &skin.proximity, l4).unwrap();
         wrist.update(&model, data, &gamma, l5).unwrap();
         guide.update(&model, data, &h_f, l6).unwrap();

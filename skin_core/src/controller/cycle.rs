@@ -8,7 +8,8 @@ use super::task_set::{CycleContext, HandSignals, TaskSet};
 use crate::hierarchy::{HierarchySolver, LevelDiagnostics};
 use crate::model::{gravity, point_jacobian, update_kinematics, ModelData};
 use crate::resolver::{Commands, Resolver};
-use crate::skin::aggregate::{aggregate_patches, FusionParams, PatchWrench};
+use crate::skin::aggregate::{aggregate_live_patches, FusionParams, PatchWrench};
+use crate::skin::live::LiveCells;
 use crate::skin::transforms::{patch_poses_world, patch_wrench_world, sum_patch_forces_in_frame};
 use crate::supervisor::blend::chi;
 use crate::supervisor::{Arrangement, Imposed, Phase, PhaseRefused, Supervisor, SupervisorInput, TorqueBlender};
@@ -56,6 +57,9 @@ pub struct Controller {
     locked: Vec<bool>,
     goal: Option<Isometry3<f64>>,
     fusion: FusionParams,
+    /// The non-silent cells of this cycle's readings (collected once, read by the skin tasks
+    /// and the aggregation).
+    live: LiveCells,
     wrenches: Vec<PatchWrench>,
     patch_poses: Vec<Isometry3<f64>>,
     ee_jacobian: Matrix6xX<f64>,
@@ -123,6 +127,7 @@ impl Controller {
             locked,
             goal: None,
             fusion: config.skin.fusion,
+            live: LiveCells::with_capacity(config.layout.num_cells()),
             wrenches: Vec::with_capacity(config.layout.patches().len()),
             patch_poses: Vec::with_capacity(config.layout.patches().len()),
             ee_jacobian: Matrix6xX::zeros(nv),
@@ -286,6 +291,7 @@ impl Controller {
             self.started = true;
         }
         self.check_rest(input)?;
+        self.live.collect(input.cells);
         update_kinematics(&self.config.model, &mut self.data, input.q, input.qd).map_err(stage("kinematics"))?;
 
         // 1. signals and arrangement
@@ -302,7 +308,7 @@ impl Controller {
         self.fusion.weight_force = arrangement.fusion_weight;
         self.output.fusion_weight = arrangement.fusion_weight;
         let layout = &self.config.layout;
-        aggregate_patches(layout, input.cells, &self.fusion, &mut self.wrenches).map_err(stage("skin aggregation"))?;
+        aggregate_live_patches(layout, &self.live, &self.fusion, &mut self.wrenches).map_err(stage("skin aggregation"))?;
         let data = &self.data;
         patch_poses_world(layout, |f| data.frame_pose(f), &mut self.patch_poses);
 
@@ -311,7 +317,7 @@ impl Controller {
             model,
             data,
             config: &self.config,
-            cells: input.cells,
+            cells: &self.live,
             hand: self.hand_signals(),
             goal: self.goal.as_ref(),
             sensing_range_m: arrangement.sensing_range_m,
@@ -378,8 +384,8 @@ impl Controller {
         let (model, data, config) = (&self.config.model, &self.data, &self.config);
         let (skin, layout) = (&config.skin, &config.layout);
         let nominal = config.supervisor.sensing_range.nominal_m;
-        let avoid = self.tasks.avoidance.summarize(layout, input.cells, &skin.proximity, nominal).map_err(stage("avoidance"))?;
-        let contact = self.tasks.contact.summarize(layout, input.cells, &skin.force, &skin.fusion).map_err(stage("contact reaction"))?;
+        let avoid = self.tasks.avoidance.summarize(layout, &self.live, &skin.proximity, nominal).map_err(stage("avoidance"))?;
+        let contact = self.tasks.contact.summarize(layout, &self.live, &skin.force, &skin.fusion).map_err(stage("contact reaction"))?;
         point_jacobian(model, data, self.ee, &nalgebra::Vector3::zeros(), &mut self.ee_jacobian)
             .map_err(stage("end-effector Jacobian"))?;
         let speed = rows_times_qd(&self.ee_jacobian, 0, input.qd).norm();

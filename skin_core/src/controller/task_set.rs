@@ -8,7 +8,7 @@ use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
 use crate::resolver::BASE_JOINTS;
 use crate::skin::aggregate::PatchWrench;
-use crate::skin::signals::CellReading;
+use crate::skin::live::LiveCells;
 use crate::tasks::avoidance::ProximityAvoidance;
 use crate::tasks::base_avoidance::BaseAvoidance;
 use crate::tasks::contact_reaction::ContactReaction;
@@ -106,7 +106,8 @@ pub(crate) struct CycleContext<'a> {
     pub(crate) model: &'a RobotModel,
     pub(crate) data: &'a ModelData,
     pub(crate) config: &'a ControllerConfig,
-    pub(crate) cells: &'a [CellReading],
+    /// The non-silent cells of this cycle's readings.
+    pub(crate) cells: &'a LiveCells,
     pub(crate) hand: HandSignals,
     pub(crate) goal: Option<&'a Isometry3<f64>>,
     pub(crate) sensing_range_m: f64,

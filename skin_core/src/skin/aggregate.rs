@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::layout::ResolvedLayout;
+use super::live::LiveCells;
 use super::params::InvalidParam;
 use super::signals::{CellReading, ForceReduction};
 
@@ -27,13 +28,18 @@ pub struct LengthMismatch {
 impl LengthMismatch {
     /// Checks that there is one reading per cell of `layout`.
     pub fn check_readings(layout: &ResolvedLayout, readings: &[CellReading]) -> Result<(), LengthMismatch> {
-        if readings.len() == layout.cells().len() {
+        Self::check_count(layout, readings.len())
+    }
+
+    /// Checks that `got` readings are one per cell of `layout`.
+    pub fn check_count(layout: &ResolvedLayout, got: usize) -> Result<(), LengthMismatch> {
+        if got == layout.cells().len() {
             Ok(())
         } else {
             Err(LengthMismatch {
                 what: "cell readings",
                 expected: layout.cells().len(),
-                got: readings.len(),
+                got,
             })
         }
     }
@@ -117,7 +123,7 @@ pub fn aggregate_patch(
     fusion: &FusionParams,
 ) -> Result<PatchWrench, LengthMismatch> {
     LengthMismatch::check_readings(layout, readings)?;
-    Ok(aggregate_range(layout, patch, readings, fusion))
+    Ok(aggregate_range(layout, patch, all_cells(layout, patch, readings), fusion))
 }
 
 /// Aggregates every patch (paper 003 eq. (6)-(8)) into `out`, indexed like `layout.patches()`.
@@ -132,37 +138,56 @@ pub fn aggregate_patches(
     LengthMismatch::check_readings(layout, readings)?;
     out.resize(layout.patches().len(), PatchWrench::default());
     for (k, w) in out.iter_mut().enumerate() {
-        *w = aggregate_range(layout, k, readings, fusion);
+        *w = aggregate_range(layout, k, all_cells(layout, k, readings), fusion);
     }
     Ok(())
 }
 
-/// No raw value above 0 (so every sanitized signal is 0, NaN included): the cell adds nothing to
-/// the wrench or the maxima, whatever `w` and the threshold are. Most cells of a skin are silent,
-/// and this test is cheaper than the sanitizing.
-#[inline]
-fn is_silent(r: &CellReading) -> bool {
-    // `|`, not `||`: one branch for the cell, not one per value
-    !((r.force[0] > 0.0) | (r.force[1] > 0.0) | (r.force[2] > 0.0) | (r.proximity > 0.0))
+/// [`aggregate_patches`] from the non-silent cells of the readings, collected once per cycle
+/// (the same wrenches: a silent cell adds nothing).
+pub fn aggregate_live_patches(
+    layout: &ResolvedLayout,
+    live: &LiveCells,
+    fusion: &FusionParams,
+    out: &mut Vec<PatchWrench>,
+) -> Result<(), LengthMismatch> {
+    LengthMismatch::check_count(layout, live.num_cells())?;
+    out.resize(layout.patches().len(), PatchWrench::default());
+    for (k, w) in out.iter_mut().enumerate() {
+        let live = live.in_range(layout.patches()[k].cells.clone());
+        *w = aggregate_range(layout, k, live.iter().map(|(i, r)| (*i, r)), fusion);
+    }
+    Ok(())
 }
 
-#[inline]
-fn aggregate_range(
+/// `(cell index, reading)` of the cells of patch `patch`.
+fn all_cells<'a>(
     layout: &ResolvedLayout,
     patch: usize,
-    readings: &[CellReading],
+    readings: &'a [CellReading],
+) -> impl Iterator<Item = (usize, &'a CellReading)> {
+    let range = layout.patches()[patch].cells.clone();
+    range.clone().zip(&readings[range])
+}
+
+/// The wrench of patch `patch` from `cells`, `(cell index, reading)` of cells of that patch.
+#[inline]
+fn aggregate_range<'a>(
+    layout: &ResolvedLayout,
+    patch: usize,
+    cells: impl Iterator<Item = (usize, &'a CellReading)>,
     fusion: &FusionParams,
 ) -> PatchWrench {
-    let range = layout.patches()[patch].cells.clone();
-    let geometry = &layout.patch_geometry[range.clone()];
-    let readings = &readings[range];
+    let geometry = &layout.patch_geometry[layout.patches()[patch].cells.clone()];
+    let first = layout.patches()[patch].cells.start;
     let (wf, wp) = (fusion.weight_force, 1.0 - fusion.weight_force);
     let mut w = PatchWrench::default();
     let mut sum_t = Vector3::zeros();
-    for (g, r) in geometry.iter().zip(readings) {
-        if is_silent(r) {
+    for (i, r) in cells {
+        if r.is_silent() {
             continue;
         }
+        let g = &geometry[i - first];
         let f = r.force_signal(fusion.force_reduction);
         let p = r.proximity_signal();
         w.max_force_signal = w.max_force_signal.max(f);
@@ -294,6 +319,26 @@ mod tests {
         let ptr = out.as_ptr();
         aggregate_patches(&l, &r, &fusion(0.5), &mut out).unwrap();
         assert_eq!((out.capacity(), out.as_ptr()), (cap, ptr));
+    }
+
+    #[test]
+    fn live_cells_give_the_same_wrenches() {
+        let mut text = String::from("patches:\n  - {id: 1, link: a}\n  - {id: 2, link: b}\ncells:\n");
+        for id in 1..=12 {
+            let (patch, x) = (1 + id / 7, 0.01 * id as f64);
+            text += &format!("  - {{id: {id}, patch: {patch}, position: [{x}, 0, 0], normal: [0, {x}, 1]}}\n");
+        }
+        let l = layout(&text);
+        let mut r = vec![CellReading::default(); l.num_cells()];
+        r[1] = CellReading::uniform(0.4, 0.0);
+        r[6].proximity = 0.7;
+        r[7].force = [0.0, 0.9, f64::NAN];
+        r[11] = CellReading::uniform(0.005, 0.0); // below the activity threshold
+        let (mut all, mut live) = (Vec::new(), Vec::new());
+        aggregate_patches(&l, &r, &fusion(0.5), &mut all).unwrap();
+        aggregate_live_patches(&l, &LiveCells::from_readings(&r), &fusion(0.5), &mut live).unwrap();
+        assert_eq!(all, live);
+        assert_eq!(live.iter().map(|w| w.active_cells).collect::<Vec<_>>(), [1, 2]);
     }
 
     #[test]

@@ -2,7 +2,9 @@
 //!
 //! Data flow per control cycle (no allocation after setup):
 //! 1. [`signals::CellReading`] per cell (indexed like [`layout::ResolvedLayout::cells`]);
-//! 2. [`aggregate::aggregate_patches`]: paper 003 eq. (6)-(8), patch wrenches in patch frames;
+//! 2. [`aggregate::aggregate_patches`]: paper 003 eq. (6)-(8), patch wrenches in patch frames
+//!    (or [`aggregate::aggregate_live_patches`] from the non-silent cells, [`live::LiveCells`],
+//!    collected once per cycle for the aggregation and the skin tasks);
 //! 3. [`transforms`]: paper 003 eq. (11) (forces into a hand frame) and eq. (13) (world wrench);
 //! 4. [`cell_forces`]: paper 000 eq. (3) repulsion and contact forces per cell, in world frame;
 //! 5. [`torques`]: `J^T F` over cells (paper 000 eq. (4), (6)) and patches (paper 003 eq. (14)).
@@ -17,6 +19,7 @@ pub mod cell_forces;
 pub mod characteristic;
 pub mod generate;
 pub mod layout;
+pub mod live;
 pub mod params;
 pub mod repulsion;
 pub mod resolved;

@@ -49,6 +49,16 @@ impl CellReading {
     pub fn proximity_signal(&self) -> f64 {
         sanitize_signal(self.proximity)
     }
+
+    /// No raw value above 0 (so every sanitized signal is 0, NaN included): the cell adds
+    /// nothing to a wrench, a signal maximum or a skin task's rows, whatever the fusion weight
+    /// and thresholds are. Most cells of a skin are silent, and this test is cheaper than the
+    /// sanitizing.
+    #[inline]
+    pub fn is_silent(&self) -> bool {
+        // `|`, not `||`: one branch for the cell, not one per value
+        !((self.force[0] > 0.0) | (self.force[1] > 0.0) | (self.force[2] > 0.0) | (self.proximity > 0.0))
+    }
 }
 
 #[cfg(test)]

@@ -21,7 +21,7 @@ use crate::skin::aggregate::LengthMismatch;
 use crate::skin::characteristic::ProximityCharacteristic;
 use crate::skin::layout::{ResolvedCell, ResolvedLayout};
 use crate::skin::repulsion::linear_repulsion;
-use crate::skin::signals::CellReading;
+use crate::skin::live::LiveCells;
 
 /// Proximity avoidance over all cells of a layout.
 #[derive(Debug, Clone)]
@@ -50,22 +50,22 @@ impl ProximityAvoidance {
         Self { params, jac: Matrix6xX::zeros(nv) }
     }
 
-    /// Fills `level` (force rows) from `readings` (indexed like `layout.cells()`) with the sensing
-    /// range `range_m` of this cycle, capped by the characteristic's range.
+    /// Fills `level` (force rows) from the non-silent cells of this cycle's readings with the
+    /// sensing range `range_m` of this cycle, capped by the characteristic's range.
     #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
         model: &RobotModel,
         data: &ModelData,
         layout: &ResolvedLayout,
-        readings: &[CellReading],
+        cells: &LiveCells,
         proximity: &ProximityCharacteristic,
         range_m: f64,
         level: &mut TaskLevel,
     ) -> Result<AvoidanceSummary, TaskError> {
         level.clear();
         let jac = &mut self.jac;
-        self.params.cells_in_range(layout, readings, proximity, range_m, |cell, fa| {
+        self.params.cells_in_range(layout, cells, proximity, range_m, |cell, fa| {
             push_inward_cell_row(model, data, cell, fa, jac, level)
         })
     }
@@ -75,26 +75,27 @@ impl ProximityAvoidance {
     pub fn summarize(
         &self,
         layout: &ResolvedLayout,
-        readings: &[CellReading],
+        cells: &LiveCells,
         proximity: &ProximityCharacteristic,
         range_m: f64,
     ) -> Result<AvoidanceSummary, TaskError> {
-        self.params.cells_in_range(layout, readings, proximity, range_m, |_, _| Ok(()))
+        self.params.cells_in_range(layout, cells, proximity, range_m, |_, _| Ok(()))
     }
 }
 
 impl AvoidanceParams {
     /// Calls `row(cell, (F_di, a_i))` for every cell within the range (eq. 3) and sums them up;
-    /// `a_i` is the row's activation over the outer `activation_band_m` of the range.
+    /// `a_i` is the row's activation over the outer `activation_band_m` of the range. Only the
+    /// non-silent cells can be in range (a silent cell's proximity signal is 0).
     fn cells_in_range(
         &self,
         layout: &ResolvedLayout,
-        readings: &[CellReading],
+        cells: &LiveCells,
         proximity: &ProximityCharacteristic,
         range_m: f64,
         mut row: impl FnMut(&ResolvedCell, (f64, f64)) -> Result<(), TaskError>,
     ) -> Result<AvoidanceSummary, TaskError> {
-        LengthMismatch::check_readings(layout, readings)?;
+        LengthMismatch::check_count(layout, cells.num_cells())?;
         let mut s = AvoidanceSummary { min_distance_m: f64::INFINITY, ..Default::default() };
         let range = range_m.min(proximity.range_m);
         if range.is_nan() || range <= 0.0 {
@@ -103,7 +104,7 @@ impl AvoidanceParams {
         let prox = proximity.prepared();
         let band = self.activation_band_m.min(range);
         let mut sum_sq = 0.0;
-        for (cell, reading) in layout.cells().iter().zip(readings) {
+        for (i, reading) in cells.cells() {
             let p = reading.proximity_signal();
             if p <= 0.0 {
                 continue;
@@ -113,7 +114,7 @@ impl AvoidanceParams {
                 continue;
             }
             let f = linear_repulsion(self.gain_n_per_m, range, d);
-            row(cell, (f, row_activation(range - d, band)))?;
+            row(&layout.cells()[*i], (f, row_activation(range - d, band)))?;
             s.rows += 1;
             sum_sq += f * f;
             s.max_force_n = s.max_force_n.max(f);

@@ -18,7 +18,7 @@ use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::{FusionParams, LengthMismatch};
 use crate::skin::characteristic::ForceCharacteristic;
 use crate::skin::layout::{ResolvedCell, ResolvedLayout};
-use crate::skin::signals::CellReading;
+use crate::skin::live::LiveCells;
 
 /// Contact reaction over all cells of a layout.
 #[derive(Debug, Clone)]
@@ -45,21 +45,21 @@ impl ContactReaction {
         Self { params, jac: Matrix6xX::zeros(nv) }
     }
 
-    /// Fills `level` (force rows) from `readings` (indexed like `layout.cells()`).
+    /// Fills `level` (force rows) from the non-silent cells of this cycle's readings.
     #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
         model: &RobotModel,
         data: &ModelData,
         layout: &ResolvedLayout,
-        readings: &[CellReading],
+        cells: &LiveCells,
         force: &ForceCharacteristic,
         fusion: &FusionParams,
         level: &mut TaskLevel,
     ) -> Result<ContactSummary, TaskError> {
         level.clear();
         let jac = &mut self.jac;
-        self.params.contact_cells(layout, readings, force, fusion, |cell, fa| {
+        self.params.contact_cells(layout, cells, force, fusion, |cell, fa| {
             push_inward_cell_row(model, data, cell, fa, jac, level)
         })
     }
@@ -68,36 +68,37 @@ impl ContactReaction {
     pub fn summarize(
         &self,
         layout: &ResolvedLayout,
-        readings: &[CellReading],
+        cells: &LiveCells,
         force: &ForceCharacteristic,
         fusion: &FusionParams,
     ) -> Result<ContactSummary, TaskError> {
-        self.params.contact_cells(layout, readings, force, fusion, |_, _| Ok(()))
+        self.params.contact_cells(layout, cells, force, fusion, |_, _| Ok(()))
     }
 }
 
 impl ContactReactionParams {
     /// Calls `row(cell, (F_ci, a_i))` for every cell in contact (eq. 6) and sums them up; `a_i`
-    /// rises with the measured force up to `activation_force_n`.
+    /// rises with the measured force up to `activation_force_n`. Only the non-silent cells can
+    /// be in contact (a silent cell's force signal is 0).
     fn contact_cells(
         &self,
         layout: &ResolvedLayout,
-        readings: &[CellReading],
+        cells: &LiveCells,
         force: &ForceCharacteristic,
         fusion: &FusionParams,
         mut row: impl FnMut(&ResolvedCell, (f64, f64)) -> Result<(), TaskError>,
     ) -> Result<ContactSummary, TaskError> {
-        LengthMismatch::check_readings(layout, readings)?;
+        LengthMismatch::check_count(layout, cells.num_cells())?;
         let mut s = ContactSummary::default();
         let force = force.prepared();
-        for (cell, reading) in layout.cells().iter().zip(readings) {
+        for (i, reading) in cells.cells() {
             let sig = reading.force_signal(fusion.force_reduction);
             if sig <= fusion.activity_threshold {
                 continue;
             }
             let measured = force.force_n(sig);
             let f = (self.gain * measured).min(self.max_force_n);
-            row(cell, (f, row_activation(measured, self.activation_force_n)))?;
+            row(&layout.cells()[*i], (f, row_activation(measured, self.activation_force_n)))?;
             s.rows += 1;
             s.max_force_n = s.max_force_n.max(f);
             s.max_measured_n = s.max_measured_n.max(measured);

@@ -6,8 +6,8 @@
 //! wall-clock time, so a run is a function of the scene (and its seed).
 //!
 //! Frozen joints of the scene (welded in the world) are seen by the controller at their fixed
-//! position with zero velocity, and their velocity commands are dropped: the controller still
-//! models them as movable, so torque it puts on them is lost motion (see `docs/scenarios.md`).
+//! position with zero velocity and are locked in it (setup `locked_joints`): no task uses them,
+//! so their commands, which the world drops, stay zero.
 
 use std::path::Path;
 use std::time::Instant;

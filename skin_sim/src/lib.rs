@@ -18,6 +18,7 @@
 #![warn(missing_docs)]
 
 pub mod bag;
+mod cell_face;
 pub mod closed_loop;
 mod frames;
 pub mod hand_force;

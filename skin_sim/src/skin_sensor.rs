@@ -5,14 +5,17 @@
 //! - Proximity: `mj_ray` from the cell's world position along its outward normal, testing only
 //!   objects and persons ([`SENSED_GROUPS`]: the robot never sees itself); the hit distance goes
 //!   through `p(d)` (0 from the sensor range on). A cell in contact reads 1.
-//! - Force: the contacts of one robot geom with one other geom (MuJoCo reports a flat contact
-//!   between boxes as the corners of the touching area) give their summed normal force
-//!   (`mj_contactForce`) to the cells of the touched body within `contact_radius_m` of the box
-//!   spanned by their points, split with weights falling linearly with that distance and
-//!   proportional to how squarely the cell faces the force; a cell keeps the part of its share
-//!   pressing along its inward normal, and that force in newtons goes through `f(F)` on all
-//!   three sensors. (Per contact point instead, a flat palm's force went to the 2-4 cells nearest
-//!   the palm's corners and saturated them: 54 N read as one saturated cell.)
+//! - Force: the contacts of one robot geom with one other geom give their summed normal force
+//!   (`mj_contactForce`), which the cells of the touched body share in proportion to how deep the
+//!   other geom presses into each cell's face ([`CellFace::compression`]: the soft cover's
+//!   pressure integrated over the cell); the cells' normal loads balance the force along its
+//!   direction ([`SkinSensor::distribute`]), and each load in newtons goes through `f(F)` on all
+//!   three sensors. MuJoCo's contact points do not decide the split: it reports a flat contact
+//!   between boxes as corners or, tilted by a hundredth of a radian, as one edge, and split by
+//!   distance to those points a flat palm's load jumped between 8 and 3 cells. When no face is
+//!   pressed (a corner or an edge of the geom between sample points), the cells within
+//!   `contact_radius_m` of the box spanned by the contact points share it, weighted by that
+//!   distance and by how squarely they face the force.
 //! - Optional zero-mean Gaussian noise on every signal (seeded), then clamped to [0, 1].
 
 use std::ops::Range;
@@ -24,6 +27,7 @@ use nalgebra::{Point3, Vector3};
 use skin_core::skin::characteristic::{PreparedForce, PreparedProximity};
 use skin_core::skin::signals::CellReading;
 
+use crate::cell_face::CellFace;
 use crate::frames::{body_pose, FrameRef};
 use crate::mjcf::{ROBOT_GROUP, SENSED_GROUPS};
 use crate::noise::Noise;
@@ -35,6 +39,7 @@ struct SimCell {
     body: usize,
     position: Point3<f64>,
     normal: Vector3<f64>,
+    face: CellFace,
     active: bool,
 }
 
@@ -69,8 +74,14 @@ pub struct SkinSensor {
     force_n: Vec<f64>,
     /// Scratch: this sample's contacts, one per pair of touching geoms.
     patches: Vec<ContactPatch>,
+    /// Scratch: weight of each cell of one body (in `by_body` order) in a patch's split.
+    weights: Vec<f64>,
     readings: Vec<CellReading>,
 }
+
+/// Smallest `-n_i · u` a loaded cell is credited with in the force balance of
+/// [`SkinSensor::distribute`]: a cell reads at most twice the contact force.
+const MIN_FACING: f64 = 0.5;
 
 /// Noise stream of the skin (see [`Noise::new`]).
 const NOISE_STREAM: u64 = 1;
@@ -86,10 +97,12 @@ impl SkinSensor {
             .zip(&skin.active)
             .map(|(c, &active)| {
                 let f = FrameRef::new(&scene.model, mj, c.frame);
+                let (position, normal) = (f.placement * Point3::from(c.position_link), f.placement * c.normal_link);
                 SimCell {
                     body: f.body,
-                    position: f.placement * Point3::from(c.position_link),
-                    normal: f.placement * c.normal_link,
+                    position,
+                    normal,
+                    face: CellFace::new(position, normal, spec.cell_radius_m),
                     active,
                 }
             })
@@ -117,6 +130,7 @@ impl SkinSensor {
             noise: Noise::new(scene.spec.seed, NOISE_STREAM),
             force_n: vec![0.0; n],
             patches: Vec::new(),
+            weights: Vec::new(),
             readings: vec![CellReading::default(); n],
         })
     }
@@ -206,26 +220,41 @@ impl SkinSensor {
         }
     }
 
-    /// Splits the patch's force (world, acting on its robot body) over the body's cells near it.
+    /// Splits the patch's force (world, acting on its robot body) over the body's cells: by the
+    /// compression of their faces, or, with none compressed, by distance to the contact points.
+    ///
+    /// A cell is a rigid plate whose force sensors read the load normal to it. The loads `N_i` are
+    /// proportional to the weights and balance the contact force along its direction `u`:
+    /// `Σ N_i (-n_i · u) = |F|`. A flat palm reads `|F|` in total; two cells meeting at 45° under
+    /// a contact on their common edge each read `0.71 |F|`, as plates there would.
     fn distribute<M: ModelType>(&mut self, data: &MjData<M>, patch: &ContactPatch) {
-        let r = self.contact_radius_m;
         let range = self.body_range[patch.body].clone();
         let pose = body_pose(data, patch.body);
-        // distance from a world point to the patch's box (world axes)
-        let to_patch = |w: Point3<f64>| (w - w.sup(&patch.min).inf(&patch.max)).norm();
         let local_f = pose.inverse_transform_vector(&patch.force);
-        let direction = local_f.normalize();
-        // A cell carries a share when it is near and faces the force (pressing = along its inward
-        // normal, -n): cells at right angles to it (a palm's rim under a flat contact) take none,
-        // so the pressing force is not lost to them.
-        let weight = |c: &SimCell| (1.0 - to_patch(pose * c.position) / r).max(0.0) * (-direction.dot(&c.normal)).max(0.0);
-        let total: f64 = self.by_body[range.clone()].iter().map(|&i| weight(&self.cells[i])).sum();
-        if total <= 0.0 {
+        let Some(u) = local_f.try_normalize(0.0) else { return };
+        let facing = |c: &SimCell| -u.dot(&c.normal);
+        let cells = &self.cells;
+        let compression = |i: usize| if facing(&cells[i]) > 0.0 { cells[i].face.compression(data, &pose, patch.geoms[1]) } else { 0.0 };
+        self.weights.clear();
+        self.weights.extend(self.by_body[range.clone()].iter().map(|&i| compression(i)));
+        if self.weights.iter().sum::<f64>() <= 0.0 {
+            let r = self.contact_radius_m;
+            // distance from a world point to the patch's box (world axes)
+            let to_patch = |w: Point3<f64>| (w - w.sup(&patch.min).inf(&patch.max)).norm();
+            // Near cells facing the force share it, squarely facing ones more: cells at right
+            // angles to it (a palm's rim under a flat contact) take none.
+            let weight = |c: &SimCell| (1.0 - to_patch(pose * c.position) / r).max(0.0) * facing(c).max(0.0);
+            self.weights.clear();
+            self.weights.extend(self.by_body[range.clone()].iter().map(|&i| weight(&cells[i])));
+        }
+        // Nearly tangential cells count as MIN_FACING: the cover carries the rest in shear.
+        let balance: f64 = self.by_body[range.clone()].iter().zip(&self.weights).map(|(&i, w)| w * facing(&cells[i]).max(MIN_FACING)).sum();
+        if balance <= 0.0 {
             return; // no skin there facing the force
         }
-        for &i in &self.by_body[range] {
-            let c = &self.cells[i];
-            self.force_n[i] += weight(c) / total * (-local_f.dot(&c.normal)).max(0.0);
+        let scale = local_f.norm() / balance;
+        for (&i, w) in self.by_body[range].iter().zip(&self.weights) {
+            self.force_n[i] += w * scale;
         }
     }
 }

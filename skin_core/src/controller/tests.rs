@@ -128,7 +128,8 @@ fn a_derived_setup_is_its_base_with_its_keys_replaced() {
     assert_ne!(table.posture, phases.posture);
     assert_eq!(ControllerSetup { posture: phases.posture.clone(), ..table }, phases);
     assert_eq!(phases.policy, Some(crate::supervisor::Policy::Phases));
-    assert_eq!(ControllerSetup { posture: tomm.posture.clone(), policy: None, hierarchy_dynamics: tomm.hierarchy_dynamics, ..phases }, tomm);
+    let resolver = tomm.resolver.clone();
+    assert_eq!(ControllerSetup { posture: tomm.posture.clone(), policy: None, hierarchy_dynamics: tomm.hierarchy_dynamics, resolver, ..phases }, tomm);
     Controller::from_setup_file(&setup("tomm_phases_table"), 0.0).expect("the base's relative paths resolve");
 }
 

@@ -117,6 +117,7 @@ fn unique_name<'a>(key: &str, name: &'a str, names: &mut Vec<&'a str>) -> Checke
 fn check_skin(s: &SkinSpec, timestep_s: f64) -> Checked {
     rate("skin.rate_hz", s.rate_hz, timestep_s)?;
     positive("skin.contact_radius_m", s.contact_radius_m)?;
+    positive("skin.cell_radius_m", s.cell_radius_m)?;
     non_negative("skin.proximity_noise_std", s.proximity_noise_std)?;
     non_negative("skin.force_noise_std", s.force_noise_std)
 }

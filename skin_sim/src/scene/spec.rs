@@ -86,10 +86,16 @@ pub struct SkinSpec {
     /// Sample rate \[Hz\] (paper 003 Sec. 4.1: 250 Hz).
     #[serde(default = "default_skin_rate")]
     pub rate_hz: f64,
-    /// Contacts are given to the cells of the touched link within this distance \[m\] (about one
-    /// cell pitch).
+    /// A contact that presses no cell's face (a corner or an edge between the faces' sample
+    /// points) is given to the cells of the touched link within this distance of its points \[m\]
+    /// (about one cell pitch).
     #[serde(default = "default_contact_radius")]
     pub contact_radius_m: f64,
+    /// Radius of a cell's sensing face \[m\]: a contact loads the cells whose faces it presses,
+    /// each in proportion to its face's compression. The cells tile the skin (hexagons of the
+    /// layout's pitch `p`, 0.03 m), so a face is the disk of a tile's area, `0.525 p`.
+    #[serde(default = "default_cell_radius")]
+    pub cell_radius_m: f64,
     /// Standard deviation of the Gaussian noise added to each proximity signal (normalized).
     #[serde(default)]
     pub proximity_noise_std: f64,
@@ -103,6 +109,9 @@ fn default_skin_rate() -> f64 {
 }
 fn default_contact_radius() -> f64 {
     0.035
+}
+fn default_cell_radius() -> f64 {
+    0.016
 }
 
 /// A planar LIDAR fan in the plane of a robot frame (its x-y plane), reported in the base frame.

@@ -33,18 +33,35 @@ pub fn update_cells(buf: &mut CellBuffer, layout: &ResolvedLayout, msg: &SkinCel
     buf.update(layout, samples, report);
 }
 
-/// Writes every layout cell's reading into `msg` (the simulation's skin driver): ids from the
+/// Writes the readings of the layout cells `k` with `keep(k)` into `msg`, in layout order (the
+/// simulation's skin driver; an event-driven skin keeps the cells that changed): ids from the
 /// layout, signals as the message's float32, acceleration and temperature zero. Reuses `msg`'s
-/// storage.
-pub fn write_cell_array(layout: &ResolvedLayout, readings: &[CellReading], stamp: &Time, msg: &mut SkinCellArray) {
+/// cells; a new one is built in Rust (r2r's `SkinCell::default` allocates a C message).
+pub fn write_cell_array(
+    layout: &ResolvedLayout,
+    readings: &[CellReading],
+    stamp: &Time,
+    mut keep: impl FnMut(usize) -> bool,
+    msg: &mut SkinCellArray,
+) {
     msg.header.stamp = stamp.clone();
-    msg.cells.resize_with(readings.len(), SkinCell::default);
-    for ((out, cell), r) in msg.cells.iter_mut().zip(layout.cells()).zip(readings) {
+    let mut n = 0;
+    for (k, (cell, r)) in layout.cells().iter().zip(readings).enumerate() {
+        if !keep(k) {
+            continue;
+        }
+        if n == msg.cells.len() {
+            let zero = Vector3Msg { x: 0.0, y: 0.0, z: 0.0 };
+            msg.cells.push(SkinCell { cell_id: 0, force: Vec::with_capacity(3), proximity: 0.0, acceleration: zero, temperature: 0.0 });
+        }
+        let out = &mut msg.cells[n];
         out.cell_id = cell.id;
         out.force.clear();
         out.force.extend(r.force.iter().map(|&f| f as f32));
         out.proximity = r.proximity as f32;
+        n += 1;
     }
+    msg.cells.truncate(n);
 }
 
 /// A normalized signal into [0, 1], with the issue it had, if any.

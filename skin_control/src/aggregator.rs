@@ -1,6 +1,6 @@
 //! The skin aggregator's work, without the node around it: cells in, patch wrenches and markers
 //! out (paper 003 eq. 6-8 through `skin_core::skin::aggregate`).
-use r2r::skin_msgs::msg::{PatchWrenchArray, SkinCellArray};
+use r2r::skin_msgs::msg::PatchWrenchArray;
 use r2r::visualization_msgs::msg::MarkerArray;
 use skin_core::skin::aggregate::{aggregate_patches, FusionParams, PatchWrench};
 use skin_core::skin::layout::ResolvedLayout;
@@ -89,7 +89,7 @@ impl Aggregator {
 mod tests {
     use super::*;
     use crate::ros_params::flatten;
-    use r2r::skin_msgs::msg::SkinCell;
+    use r2r::skin_msgs::msg::{SkinCell, SkinCellArray};
     use skin_core::model::RobotModel;
     use skin_core::skin::layout::SkinLayout;
     use skin_core::skin::params::SkinParams;

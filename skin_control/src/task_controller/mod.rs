@@ -13,7 +13,7 @@ use r2r::builtin_interfaces::msg::Time;
 use r2r::geometry_msgs::msg::{PoseStamped, Twist};
 use r2r::nav_msgs::msg::Odometry;
 use r2r::sensor_msgs::msg::{JointState, LaserScan};
-use r2r::skin_msgs::msg::{Arrangement as ArrangementMsg, ControllerState, SkinCellArray};
+use r2r::skin_msgs::msg::{Arrangement as ArrangementMsg, ControllerState};
 use r2r::std_msgs::msg::Float64MultiArray;
 use serde::{Deserialize, Serialize};
 use skin_core::controller::{Controller, ControllerConfig, ControllerInput};

@@ -95,7 +95,9 @@ fn main() -> Result<()> {
         let sent = Instant::now();
         cells_pub.publish(&cells)?;
         loop {
-            node.spin_once(Duration::from_micros(200));
+            // rcl_wait returns as soon as the command arrives: a longer timeout only spares the
+            // controller the probe's polling (both share the machine's cores)
+            node.spin_once(Duration::from_millis(50));
             if commands.next().now_or_never().flatten().is_some() {
                 break;
             }

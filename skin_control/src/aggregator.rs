@@ -1,11 +1,11 @@
 //! The skin aggregator's work, without the node around it: cells in, patch wrenches and markers
 //! out (paper 003 eq. 6-8 through `skin_core::skin::aggregate`).
-use r2r::skin_msgs::msg::{PatchWrenchArray, SkinCellArray};
+use r2r::skin_msgs::msg::PatchWrenchArray;
 use r2r::visualization_msgs::msg::MarkerArray;
 use skin_core::skin::aggregate::{aggregate_patches, FusionParams, PatchWrench};
 use skin_core::skin::layout::ResolvedLayout;
 
-use crate::convert::{update_cells, write_patch_array, CellBuffer, Issue, IssueCounts};
+use crate::convert::{update_cells, write_patch_array, CellBuffer, CellMessage, Issue, IssueCounts};
 use crate::markers::SkinMarkers;
 
 /// `ros2 param describe` texts of the skin model parameters (`skin_core::skin::params::SkinParams`,
@@ -58,12 +58,12 @@ impl Aggregator {
         self.cells.issues()
     }
 
-    /// Takes one `SkinCellArray` (issues go to `report`) and returns the `/skin/patches` message
-    /// (every patch, stamped like the cells) and the `/skin/markers` update (empty when RViz is
-    /// already up to date).
+    /// Takes one `/skin/cells` message (issues go to `report`) and returns the `/skin/patches`
+    /// message (every patch, stamped like the cells) and the `/skin/markers` update (empty when
+    /// RViz is already up to date).
     pub fn process(
         &mut self,
-        msg: &SkinCellArray,
+        msg: &impl CellMessage,
         fusion: &FusionParams,
         report: impl FnMut(&Issue),
     ) -> (&PatchWrenchArray, &MarkerArray) {
@@ -71,14 +71,14 @@ impl Aggregator {
         let readings = self.cells.readings();
         aggregate_patches(&self.layout, readings, fusion, &mut self.wrenches)
             .expect("the cell buffer has one reading per layout cell");
-        let stamp = &msg.header.stamp;
-        write_patch_array(&self.layout, &self.wrenches, stamp, &mut self.patches_msg);
+        let stamp = msg.stamp();
+        write_patch_array(&self.layout, &self.wrenches, &stamp, &mut self.patches_msg);
         self.markers.update(
             &self.layout,
             readings,
             fusion,
             &self.wrenches,
-            stamp,
+            &stamp,
             &mut self.markers_msg,
         );
         (&self.patches_msg, &self.markers_msg)
@@ -89,7 +89,7 @@ impl Aggregator {
 mod tests {
     use super::*;
     use crate::ros_params::flatten;
-    use r2r::skin_msgs::msg::SkinCell;
+    use r2r::skin_msgs::msg::{SkinCell, SkinCellArray};
     use skin_core::model::RobotModel;
     use skin_core::skin::layout::SkinLayout;
     use skin_core::skin::params::SkinParams;

@@ -14,6 +14,7 @@ use r2r::sensor_msgs::msg::{JointState, LaserScan};
 use r2r::skin_msgs::msg::{ControllerState, SkinCellArray};
 use r2r::std_msgs::msg::Float64MultiArray;
 use serde::Serialize;
+use skin_core::skin::layout::ResolvedLayout;
 use skin_core::skin::signals::CellReading;
 use skin_core::supervisor::Mode;
 use skin_sim::runner::Decision;
@@ -216,8 +217,7 @@ impl SimBridge {
         let sent = &mut self.sent_cells;
         m.cells = w.scene().skin.as_ref().map(|skin| {
             let mut c = m.cells.take().unwrap_or_default();
-            write_cell_array(&skin.layout, w.skin_readings(), &stamp, &mut c);
-            keep_events(&mut c, w.skin_readings(), sent);
+            write_events(&skin.layout, w.skin_readings(), &stamp, sent, &mut c);
             c
         });
         m.goal = None;
@@ -260,19 +260,14 @@ impl SimBridge {
     }
 }
 
-/// Keeps in `msg` (every cell, layout order) the cells an event-driven skin sends: those that read
-/// something, or changed since `sent` (the last message's readings, updated here). A subscriber
-/// that keeps each cell's last reading and reads zero before the first (`convert::CellBuffer`)
-/// sees every cell as if all were sent, also when it joins late; the message shrinks from every
-/// cell to the few near something, which is most of the graph's serialization cost.
-fn keep_events(msg: &mut SkinCellArray, readings: &[CellReading], sent: &mut Vec<CellReading>) {
+/// Writes into `msg` the cells an event-driven skin sends: those that read something, or changed
+/// since `sent` (the last message's readings, updated here). A subscriber that keeps each cell's
+/// last reading and reads zero before the first (`convert::CellBuffer`) sees every cell as if all
+/// were sent, also when it joins late; the message shrinks from every cell to the few near
+/// something, which is most of the graph's serialization cost.
+fn write_events(layout: &ResolvedLayout, readings: &[CellReading], stamp: &Time, sent: &mut Vec<CellReading>, msg: &mut SkinCellArray) {
     let zero = CellReading::default();
-    let mut k = 0;
-    msg.cells.retain(|_| {
-        let r = readings[k];
-        k += 1;
-        r != zero || sent.get(k - 1) != Some(&r)
-    });
+    write_cell_array(layout, readings, stamp, |k| readings[k] != zero || sent.get(k) != Some(&readings[k]), msg);
     sent.clear();
     sent.extend_from_slice(readings);
 }
@@ -328,7 +323,6 @@ pub fn run_in_process(
 mod tests {
     use super::*;
     use crate::ros_params::flatten;
-    use r2r::skin_msgs::msg::SkinCell;
     use crate::task_controller::{SupervisorSource, TaskController, TaskControllerParams, Trigger};
     use skin_core::controller::ControllerConfig;
     use skin_sim::closed_loop::ClosedLoop;
@@ -338,26 +332,26 @@ mod tests {
     /// changed (a cell back to zero once), never an unchanged zero one.
     #[test]
     fn cell_messages_carry_the_active_and_changed_cells() {
-        let layout_of = |n: u32| SkinCellArray { cells: (1..=n).map(|id| SkinCell { cell_id: id, ..Default::default() }).collect(), ..Default::default() };
+        let layout = skin_core::skin::layout::SkinLayout::from_yaml_str(include_str!("../../skin_core/src/skin/testdata/two_patches.yaml"), "two_patches.yaml")
+            .unwrap()
+            .resolve_with(|l| Some(if l == "a" { 1 } else { 2 }))
+            .unwrap();
         let mut sent = Vec::new();
-        let ids = |m: &SkinCellArray| m.cells.iter().map(|c| c.cell_id).collect::<Vec<_>>();
+        let mut m = SkinCellArray::default();
+        let mut ids = |readings: &[CellReading]| {
+            write_events(&layout, readings, &Time::default(), &mut sent, &mut m);
+            m.cells.iter().map(|c| c.cell_id).collect::<Vec<_>>()
+        };
         let zero = CellReading::default();
         let touched = CellReading::uniform(0.0, 0.5);
-        let mut m = layout_of(4);
-        keep_events(&mut m, &[zero, touched, zero, zero], &mut sent);
-        assert_eq!(ids(&m), [1, 2, 3, 4]);
-        let mut m = layout_of(4);
-        keep_events(&mut m, &[zero, touched, zero, touched], &mut sent);
-        assert_eq!(ids(&m), [2, 4]);
-        let mut m = layout_of(4);
-        keep_events(&mut m, &[zero, zero, zero, touched], &mut sent);
-        assert_eq!(ids(&m), [2, 4]);
-        let mut m = layout_of(4);
-        keep_events(&mut m, &[zero; 4], &mut sent);
-        assert_eq!(ids(&m), [4]);
-        let mut m = layout_of(4);
-        keep_events(&mut m, &[zero; 4], &mut sent);
-        assert!(m.cells.is_empty());
+        assert_eq!(ids(&[zero, touched, zero]), [10, 11, 20]);
+        assert_eq!(ids(&[zero, touched, touched]), [11, 20]);
+        assert_eq!(ids(&[zero, zero, touched]), [11, 20]);
+        assert_eq!(ids(&[zero; 3]), [20]);
+        assert!(ids(&[zero; 3]).is_empty());
+        assert_eq!(ids(&[touched, zero, zero]), [10]);
+        assert_eq!(m.cells[0].force, [0.0; 3]);
+        assert_eq!(m.cells[0].proximity, 0.5);
     }
 
     /// The graph's loop without DDS against skin_sim's in-process loop: the only difference is

@@ -39,7 +39,7 @@ fn run() -> Result<Option<bool>> {
     let mut pool = LocalPool::new();
     let mut handle = mujoco_sim::start(&mut node, &pool.spawner(), args.options)?;
     let mut failure = None;
-    nodes::spin_passes(&mut [&mut node], &mut pool, || match handle.poll() {
+    nodes::spin(&mut node, &mut pool, || match handle.poll() {
         Ok(pass) => pass,
         Err(e) => {
             failure = Some(e);

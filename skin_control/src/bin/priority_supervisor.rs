@@ -3,7 +3,7 @@
 use anyhow::{Context as _, Result};
 use clap::Parser;
 use futures::executor::LocalPool;
-use skin_control::nodes::{self, priority_supervisor};
+use skin_control::nodes::{self, priority_supervisor, Pass};
 use skin_control::shutdown;
 
 /// Priority supervisor: /controller/state in, /supervisor/arrangement out (reliable, transient
@@ -29,7 +29,7 @@ fn main() -> Result<()> {
     let mut node = r2r::Node::create(ctx, priority_supervisor::NODE, "")?;
     let mut pool = LocalPool::new();
     let handle = priority_supervisor::start(&mut node, &pool.spawner(), args.options)?;
-    nodes::spin(&mut [&mut node], &mut pool, || false);
+    nodes::spin(&mut node, &mut pool, || Pass::Idle);
     handle.stop();
     Ok(())
 }

@@ -148,7 +148,7 @@ fn main() -> Result<()> {
     let (param_services, mut param_changes) = node
         .make_derived_parameter_handler(served)
         .context("declaring the parameters")?;
-    let mut cells = node.subscribe::<SkinCellArray>(CELLS_TOPIC, qos::every_sample())?;
+    let mut cells = node.subscribe_native::<SkinCellArray>(CELLS_TOPIC, qos::every_sample())?;
     let patches_pub = node.create_publisher::<PatchWrenchArray>(PATCHES_TOPIC, qos::stream())?;
     let markers_pub = node.create_publisher::<MarkerArray>(MARKERS_TOPIC, qos::stream())?;
     r2r::log_info!(

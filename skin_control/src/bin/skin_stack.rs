@@ -85,7 +85,7 @@ fn run() -> Result<Option<bool>> {
                 record: args.record.clone(),
                 out: args.out.clone(),
                 controller: args.setup.as_ref().map(PathBuf::from),
-                // in one process the nodes' subscriptions exist before the first state
+                // the lockstep default: the controller's required inputs
                 wait_topic_subscribers: vec![],
             };
             Some(mujoco_sim::start(node, &spawner, options)?)
@@ -107,23 +107,25 @@ fn run() -> Result<Option<bool>> {
 
     let mut failure = None;
     {
-        let mut all: Vec<&mut r2r::Node> = vec![&mut tc_node, &mut sup_node];
-        if let Some(n) = sim_node.as_mut() {
-            all.push(n);
-        }
-        nodes::spin_passes(&mut all, &mut pool, || {
+        let mut tc_poll = || {
             let cycles = tc.counts().0;
             tc.poll();
-            let controlled = if tc.counts().0 == cycles { Pass::Idle } else { Pass::Busy };
-            match sim.as_mut().map(|s| s.poll()) {
-                Some(Ok(Pass::Idle)) | None => controlled,
-                Some(Ok(pass)) => pass,
-                Some(Err(e)) => {
-                    failure = Some(e);
-                    Pass::Done
-                }
+            if tc.counts().0 == cycles { Pass::Idle } else { Pass::Busy }
+        };
+        let mut sup_poll = || Pass::Idle;
+        let mut sim_poll = || match sim.as_mut().map(|s| s.poll()) {
+            Some(Ok(pass)) => pass,
+            None => Pass::Idle,
+            Some(Err(e)) => {
+                failure = Some(e);
+                Pass::Done
             }
-        });
+        };
+        let mut all: Vec<(&mut r2r::Node, &mut dyn FnMut() -> Pass)> = vec![(&mut tc_node, &mut tc_poll), (&mut sup_node, &mut sup_poll)];
+        if let Some(n) = sim_node.as_mut() {
+            all.push((n, &mut sim_poll));
+        }
+        nodes::spin_nodes(&mut all, &mut pool);
     }
     tc.stop();
     sup.stop();

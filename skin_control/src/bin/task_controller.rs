@@ -3,7 +3,7 @@
 use anyhow::{Context as _, Result};
 use clap::Parser;
 use futures::executor::LocalPool;
-use skin_control::nodes::{self, task_controller};
+use skin_control::nodes::{self, task_controller, Pass};
 use skin_control::shutdown;
 
 /// Whole-body skin controller: /joint_states, /base/odom, /scan, /skin/cells, /goal,
@@ -30,9 +30,9 @@ fn main() -> Result<()> {
     let mut node = r2r::Node::create(ctx, task_controller::NODE, "")?;
     let mut pool = LocalPool::new();
     let handle = task_controller::start(&mut node, &pool.spawner(), args.options)?;
-    nodes::spin(&mut [&mut node], &mut pool, || {
+    nodes::spin(&mut node, &mut pool, || {
         handle.poll();
-        false
+        Pass::Idle
     });
     handle.stop();
     // Let the zero commands leave before the node goes away.

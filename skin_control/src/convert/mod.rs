@@ -21,30 +21,86 @@ use nalgebra::Vector3;
 use r2r::builtin_interfaces::msg::Time;
 use r2r::geometry_msgs::msg::{Point, Vector3 as Vector3Msg};
 use r2r::skin_msgs::msg::{PatchWrench as PatchWrenchMsg, PatchWrenchArray, SkinCell, SkinCellArray};
+use r2r::NativeMsg;
 use skin_core::skin::aggregate::PatchWrench;
 pub use skin_core::skin::cell_input::{CellBuffer, CellSample, Issue, IssueCounts, IssueKind};
 use skin_core::skin::layout::ResolvedLayout;
 use skin_core::skin::signals::CellReading;
 
-/// Writes the cells of `msg` into `buf` (the rules of `skin_core::skin::cell_input`); `report`
-/// is called for every issue. No allocation.
-pub fn update_cells(buf: &mut CellBuffer, layout: &ResolvedLayout, msg: &SkinCellArray, report: impl FnMut(&Issue)) {
-    let samples = msg.cells.iter().map(|c| CellSample { cell_id: c.cell_id, force: &c.force, proximity: c.proximity });
-    buf.update(layout, samples, report);
+/// A `/skin/cells` message as the cell rules read it: r2r's Rust message, or the C message that a
+/// native subscription (`Node::subscribe_native`) takes it into. The nodes read the C message:
+/// r2r's Rust message costs an allocation per cell (its `force` is a `Vec`), and the cells are
+/// most of the graph's traffic (700 on TOMM).
+pub trait CellMessage {
+    /// `header.stamp`.
+    fn stamp(&self) -> Time;
+    /// The cells, in message order.
+    fn samples(&self) -> impl Iterator<Item = CellSample<'_>>;
 }
 
-/// Writes every layout cell's reading into `msg` (the simulation's skin driver): ids from the
+impl CellMessage for SkinCellArray {
+    fn stamp(&self) -> Time {
+        self.header.stamp.clone()
+    }
+
+    fn samples(&self) -> impl Iterator<Item = CellSample<'_>> {
+        self.cells.iter().map(|c| CellSample { cell_id: c.cell_id, force: &c.force, proximity: c.proximity })
+    }
+}
+
+impl CellMessage for NativeMsg<SkinCellArray> {
+    fn stamp(&self) -> Time {
+        Time { sec: self.header.stamp.sec, nanosec: self.header.stamp.nanosec }
+    }
+
+    fn samples(&self) -> impl Iterator<Item = CellSample<'_>> {
+        let seq = &self.cells;
+        let cells = if seq.data.is_null() {
+            &[][..]
+        } else {
+            // SAFETY: a rosidl sequence: `data` points at `size` initialized cells, owned by the
+            // message, which the returned samples borrow.
+            unsafe { std::slice::from_raw_parts(seq.data, seq.size) }
+        };
+        cells.iter().map(|c| CellSample { cell_id: c.cell_id, force: &c.force, proximity: c.proximity })
+    }
+}
+
+/// Writes the cells of `msg` into `buf` (the rules of `skin_core::skin::cell_input`); `report`
+/// is called for every issue. No allocation.
+pub fn update_cells(buf: &mut CellBuffer, layout: &ResolvedLayout, msg: &impl CellMessage, report: impl FnMut(&Issue)) {
+    buf.update(layout, msg.samples(), report);
+}
+
+/// Writes the readings of the layout cells `k` with `keep(k)` into `msg`, in layout order (the
+/// simulation's skin driver; an event-driven skin keeps the cells that changed): ids from the
 /// layout, signals as the message's float32, acceleration and temperature zero. Reuses `msg`'s
-/// storage.
-pub fn write_cell_array(layout: &ResolvedLayout, readings: &[CellReading], stamp: &Time, msg: &mut SkinCellArray) {
+/// cells; a new one is built in Rust (r2r's `SkinCell::default` allocates a C message).
+pub fn write_cell_array(
+    layout: &ResolvedLayout,
+    readings: &[CellReading],
+    stamp: &Time,
+    mut keep: impl FnMut(usize) -> bool,
+    msg: &mut SkinCellArray,
+) {
     msg.header.stamp = stamp.clone();
-    msg.cells.resize_with(readings.len(), SkinCell::default);
-    for ((out, cell), r) in msg.cells.iter_mut().zip(layout.cells()).zip(readings) {
+    let mut n = 0;
+    for (k, (cell, r)) in layout.cells().iter().zip(readings).enumerate() {
+        if !keep(k) {
+            continue;
+        }
+        if n == msg.cells.len() {
+            let zero = Vector3Msg { x: 0.0, y: 0.0, z: 0.0 };
+            msg.cells.push(SkinCell { cell_id: 0, force: Vec::with_capacity(3), proximity: 0.0, acceleration: zero, temperature: 0.0 });
+        }
+        let out = &mut msg.cells[n];
         out.cell_id = cell.id;
         out.force.clear();
         out.force.extend(r.force.iter().map(|&f| f as f32));
         out.proximity = r.proximity as f32;
+        n += 1;
     }
+    msg.cells.truncate(n);
 }
 
 /// A normalized signal into [0, 1], with the issue it had, if any.
@@ -266,6 +322,31 @@ mod tests {
         let mut issues = Vec::new();
         update_cells(buf, l, msg, |i| issues.push(*i));
         issues
+    }
+
+    /// The C message of a native subscription reads exactly as r2r's Rust message: readings,
+    /// issues, stamp (every sanitize rule a C message can carry: its force has three values).
+    #[test]
+    fn native_cells_read_as_rust_cells() {
+        let l = layout();
+        let mut msg = cells(vec![
+            cell(11, [0.5, f32::NAN, 2.0], -0.5),
+            cell(99, [0.1; 3], 0.1),
+            cell(10, [0.25; 3], f32::INFINITY),
+            cell(11, [0.9; 3], 0.9),
+        ]);
+        msg.header.stamp = Time { sec: 3, nanosec: 7 };
+        let native = NativeMsg::from(&msg);
+        assert_eq!(native.stamp(), msg.stamp());
+        let (mut a, mut b) = (CellBuffer::new(&l), CellBuffer::new(&l));
+        let issues = update(&mut a, &l, &msg);
+        let mut native_issues = Vec::new();
+        update_cells(&mut b, &l, &native, |i| native_issues.push(*i));
+        assert_eq!(issues.len(), 6);
+        // (the NaN value of an issue is not equal to itself)
+        assert_eq!(format!("{native_issues:?}"), format!("{issues:?}"));
+        assert_eq!(a.readings(), b.readings());
+        assert_eq!(NativeMsg::from(&cells(Vec::new())).samples().count(), 0);
     }
 
     #[test]

@@ -123,18 +123,10 @@ pub fn cli_args() -> impl Iterator<Item = String> {
     std::env::args().take_while(|a| a != "--ros-args")
 }
 
-/// Spins `nodes` and runs `pool` until SIGINT/SIGTERM (or `done()` holds). One node waits in
-/// its wait set (woken by its own traffic); several nodes (r2r has no shared wait set) are
-/// polled: the first waits at most 100 us, the others are only checked, so a message to any
-/// node waits at most ~100 us for its turn.
-pub fn spin(nodes: &mut [&mut r2r::Node], pool: &mut futures::executor::LocalPool, mut done: impl FnMut() -> bool) {
-    spin_passes(nodes, pool, || if done() { Pass::Done } else { Pass::Idle });
-}
-
-/// What the poll of one pass of [`spin_passes`] did.
+/// What a node's poll in [`spin_nodes`] did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Pass {
-    /// Nothing sent: the next pass may wait for traffic.
+    /// Nothing sent: the next round may wait for traffic.
     Idle,
     /// Something was published: a node of this process may have a message already.
     Busy,
@@ -142,20 +134,31 @@ pub enum Pass {
     Done,
 }
 
-/// [`spin`] with a poll that says whether it published: after a busy pass no node waits (a
-/// message from one composed node to another is delivered at once, and waiting in the first
-/// node's wait set would hold it up to 100 us).
-pub fn spin_passes(nodes: &mut [&mut r2r::Node], pool: &mut futures::executor::LocalPool, mut poll: impl FnMut() -> Pass) {
+/// [`spin_nodes`] with one node.
+pub fn spin(node: &mut r2r::Node, pool: &mut futures::executor::LocalPool, mut poll: impl FnMut() -> Pass) {
+    spin_nodes(&mut [(node, &mut poll)], pool);
+}
+
+/// Spins each node, runs `pool` (its tasks take what the node took) and calls the node's poll,
+/// node after node, until SIGINT/SIGTERM or a poll says [`Pass::Done`]. One node waits in its
+/// wait set (woken by its own traffic). Several nodes (r2r has no shared wait set) are polled:
+/// after a round in which nothing was published the first node waits at most 100 us, the
+/// others are only checked. A node's poll runs right after its own messages are in, so a
+/// lockstep period (the simulator's state to the controller, its commands back) takes one round
+/// of spins, not one round per hop: each `spin_once` builds and tears down an rcl wait set.
+pub fn spin_nodes(nodes: &mut [(&mut r2r::Node, &mut dyn FnMut() -> Pass)], pool: &mut futures::executor::LocalPool) {
     let wait = if nodes.len() > 1 { Duration::from_micros(100) } else { Duration::from_millis(5) };
+    let mut busy = false;
     while !crate::shutdown::requested() {
-        let first = match poll() {
-            Pass::Done => return,
-            Pass::Busy => Duration::ZERO,
-            Pass::Idle => wait,
-        };
-        for (k, node) in nodes.iter_mut().enumerate() {
-            node.spin_once(if k == 0 { first } else { Duration::ZERO });
+        let may_wait = !std::mem::replace(&mut busy, false);
+        for (k, (node, poll)) in nodes.iter_mut().enumerate() {
+            node.spin_once(if k == 0 && may_wait { wait } else { Duration::ZERO });
+            pool.run_until_stalled();
+            match poll() {
+                Pass::Done => return,
+                Pass::Busy => busy = true,
+                Pass::Idle => {}
+            }
         }
-        pool.run_until_stalled();
     }
 }

@@ -61,7 +61,9 @@ pub struct Options {
     #[arg(long, default_value_t = 1.0, value_name = "SECONDS")]
     pub resend: f64,
     /// Lockstep: before the first state, wait (at most 30 s) until TOPIC has N subscribers, e.g.
-    /// `/skin/cells=3` when the controller, the aggregator and a recorder must all get it.
+    /// `/skin/cells=3` when the controller, the aggregator and a recorder must all get it
+    /// [default: 1 on /joint_states, and on /skin/cells and /base/odom when the scene has a skin
+    /// and a base: the inputs a controller requires].
     #[arg(long, num_args = 1.., value_name = "TOPIC=N", value_parser = crate::rosbag::play::topic_count)]
     pub wait_topic_subscribers: Vec<(String, usize)>,
     /// Command namespaces, one per arm (default: /left_arm /right_arm for TOMM, else /arm).
@@ -133,6 +135,9 @@ pub struct SimHandle {
     sent_at: Option<Instant>,
     next_tick: Instant,
     started: Instant,
+    /// When the first state went out: the run's wall time counts from here (start-up and
+    /// discovery excluded, as skin_sim's in-process runs exclude their set-up).
+    running: Option<Instant>,
     record: Vec<AppliedCommand>,
     periods: u64,
     resends: u64,
@@ -270,6 +275,11 @@ impl SimHandle {
         Ok(())
     }
 
+    /// Wall time since the first state \[s\] (0 before it).
+    fn run_wall_s(&self) -> f64 {
+        self.running.map_or(0.0, |r| r.elapsed().as_secs_f64())
+    }
+
     /// A progress line at every tenth of the run.
     fn log_progress(&mut self) {
         let t = self.bridge.world().time();
@@ -277,7 +287,7 @@ impl SimHandle {
             return;
         }
         self.progress_s += self.end_s / 10.0;
-        let rtf = t / self.started.elapsed().as_secs_f64().max(1e-9);
+        let rtf = t / self.run_wall_s().max(1e-9);
         r2r::log_info!(&self.logger, "t = {t:.1} / {:.1} s (real-time factor {rtf:.2})", self.end_s);
     }
 
@@ -293,6 +303,7 @@ impl SimHandle {
                 self.clear_inbox();
                 self.publish_state()?;
                 self.sent_at = Some(Instant::now());
+                self.running = self.sent_at;
                 return Ok(Pass::Busy);
             };
             if self.take_commands(true) {
@@ -320,6 +331,7 @@ impl SimHandle {
             if now < self.next_tick {
                 return Ok(Pass::Idle);
             }
+            self.running.get_or_insert(now);
             self.take_commands(false);
             self.advance()?;
             self.publish_state()?;
@@ -335,15 +347,17 @@ impl SimHandle {
     /// Writes the record (if asked) and logs the summary; with `--out` writes the run's files,
     /// prints its summary and returns whether every outcome check passed.
     pub fn stop(self) -> Result<Option<bool>> {
-        let wall = self.started.elapsed().as_secs_f64();
+        let wall = self.run_wall_s();
         let sim = self.bridge.world().time();
+        let start_up = self.running.unwrap_or_else(Instant::now) - self.started;
         r2r::log_info!(
             &self.logger,
-            "stopping at t = {sim:.3} s after {} periods ({} resends, {} bad commands); real-time factor {:.2}",
+            "stopping at t = {sim:.3} s after {} periods ({} resends, {} bad commands); real-time factor {:.2} ({wall:.3} s from the first state, {:.3} s of start-up before it)",
             self.periods,
             self.resends,
             self.inbox.borrow().errors,
-            sim / wall.max(1e-9)
+            sim / wall.max(1e-9),
+            start_up.as_secs_f64()
         );
         if let Some(path) = &self.options.record {
             let json = serde_json::json!({
@@ -385,6 +399,13 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
     let bridge = SimBridge::new(scene.clone(), &options.arm_namespaces, &options.arm_prefixes).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
     let recorder = options.out.as_ref().map(|dir| start_recorder(&options, scene, &bridge, dir)).transpose()?;
     let end_s = options.duration.unwrap_or(bridge.duration_s());
+    if options.lockstep && options.wait_topic_subscribers.is_empty() {
+        // A state sent before the controller's readers are matched is lost, and the lockstep
+        // would stall for a `--resend` period.
+        let skin = bridge.world().scene().skin.is_some();
+        let required = [(JOINT_STATES, true), (CELLS, skin), (ODOM, bridge.has_base())];
+        options.wait_topic_subscribers = required.iter().filter(|(_, r)| *r).map(|(t, _)| (t.to_string(), 1)).collect();
+    }
     let pubs = Pubs {
         clock: node.create_publisher(CLOCK, qos::stream())?,
         joints: node.create_publisher(JOINT_STATES, qos::stream())?,
@@ -435,6 +456,7 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
         sent_at: None,
         next_tick: Instant::now(),
         started: Instant::now(),
+        running: None,
         record: Vec::new(),
         periods: 0,
         resends: 0,

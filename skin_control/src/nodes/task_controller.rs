@@ -238,7 +238,7 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
             s.refused(result);
         })?;
     }
-    let cells = node.subscribe::<SkinCellArray>(CELLS, qos::every_sample())?;
+    let cells = node.subscribe_native::<SkinCellArray>(CELLS, qos::every_sample())?;
     spawn_sub(spawner, cells, &shared, |s, msg| {
         let now = s.now();
         let Shared { tc, logger, .. } = &mut *s;

@@ -13,7 +13,7 @@ use r2r::builtin_interfaces::msg::Time;
 use r2r::geometry_msgs::msg::{PoseStamped, Twist};
 use r2r::nav_msgs::msg::Odometry;
 use r2r::sensor_msgs::msg::{JointState, LaserScan};
-use r2r::skin_msgs::msg::{Arrangement as ArrangementMsg, ControllerState, SkinCellArray};
+use r2r::skin_msgs::msg::{Arrangement as ArrangementMsg, ControllerState};
 use r2r::std_msgs::msg::Float64MultiArray;
 use serde::{Deserialize, Serialize};
 use skin_core::controller::{Controller, ControllerConfig, ControllerInput};
@@ -26,7 +26,7 @@ use crate::convert::control::{
     imposed_of, split_arms, twist_msg, write_arm_command, write_controller_state, ArmCommand,
 };
 use crate::convert::robot::{goal_pose, time_s, JointIssue, JointStateIssue, ScanConverter, StateBuffer};
-use crate::convert::{update_cells, CellBuffer, Issue, IssueKind};
+use crate::convert::{update_cells, CellBuffer, CellMessage, Issue, IssueKind};
 use crate::input_health::{IssueTable, StampGate, StampIssue};
 use crate::nodes::topics::{ARRANGEMENT, CELLS, FORCE_REFERENCE, GOAL, JOINT_STATES, ODOM, SCAN};
 
@@ -381,16 +381,17 @@ impl TaskController {
     }
 
     /// `/skin/cells` at node time `now_s`; `report` gets the first issue of each kind.
-    pub fn on_cells(&mut self, msg: &SkinCellArray, now_s: f64, mut report: impl FnMut(&Issue)) -> Result<(), InputError> {
+    pub fn on_cells(&mut self, msg: &impl CellMessage, now_s: f64, mut report: impl FnMut(&Issue)) -> Result<(), InputError> {
         let lead = self.params.max_stamp_lead_s;
-        self.health.check_stamp(Timed::Cells, &msg.header.stamp, self.clock(now_s), lead)?;
+        let stamp = msg.stamp();
+        self.health.check_stamp(Timed::Cells, &stamp, self.clock(now_s), lead)?;
         let (table, first) = (&mut self.health.table, self.health.cell_kinds);
         update_cells(&mut self.cells, &self.controller.config().layout, msg, |i| {
             if table.count(first + i.kind as usize) {
                 report(i);
             }
         });
-        self.cells_stamp = Some(msg.header.stamp.clone());
+        self.cells_stamp = Some(stamp);
         Ok(())
     }
 

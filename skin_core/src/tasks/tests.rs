@@ -73,7 +73,7 @@ fn shipped_params_load_and_errors_name_file_and_key() {
     let p = TaskParams::load(&root().join("config/tasks.yaml")).unwrap();
     assert!(p.goal.v_max_m_per_s > 0.0);
     let text = std::fs::read_to_string(root().join("config/tasks.yaml")).unwrap();
-    let bad = text.replace("alpha_m: 0.15", "alpha_m: -1.0");
+    let bad = text.replace("alpha_m: 0.10", "alpha_m: -1.0");
     let e = TaskParams::from_yaml_str(&bad, "t.yaml").unwrap_err();
     assert!(matches!(e, ParamsError::Invalid { .. }));
     let msg = e.to_string();

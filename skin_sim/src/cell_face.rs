@@ -7,8 +7,8 @@
 //! polynomials), and the compression at a sample point is how far the touching geom's surface lies
 //! beyond it along the cell's outward normal (a ray from behind the face, `mju_rayGeom`).
 
-use mujoco_rs::mujoco_c;
 use mujoco_rs::prelude::*;
+use mujoco_rs::wrappers::fun::utility::mju_ray_geom;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
 use nalgebra::{Isometry3, Point3, Vector3};
 
@@ -49,16 +49,14 @@ impl CellFace {
         let model = data.model();
         let n = pose * self.normal;
         let (pos, mat, size) = (&data.geom_xpos()[geom], &data.geom_xmat()[geom], &model.geom_size()[geom]);
-        let kind = model.geom_type()[geom] as i32;
+        let kind = model.geom_type()[geom];
         let dir = [n.x, n.y, n.z];
         self.points
             .iter()
             .zip(WEIGHTS)
             .map(|(p, w)| {
                 let o = pose * p - n * REACH_M;
-                let mut hit_normal = [0.0; 3];
-                // SAFETY: every pointer is to a live 3- or 9-element array of this geom.
-                let t = unsafe { mujoco_c::mju_rayGeom(pos, mat, size, &[o.x, o.y, o.z], &dir, kind, &mut hit_normal) };
+                let t = mju_ray_geom(pos, mat, size, &[o.x, o.y, o.z], &dir, kind, None);
                 if t >= 0.0 {
                     w * (REACH_M - t).max(0.0)
                 } else {

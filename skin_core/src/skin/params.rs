@@ -86,13 +86,65 @@ pub fn parse_validated<T: DeserializeOwned>(
     Ok(p)
 }
 
-/// Reads the file at `path`, then [`parse_validated`].
+/// Reads the file at `path`, then [`parse_validated`]. A file with an `extends` key (another
+/// parameter file, relative to this one; not `base` as in the controller setups: the resolver
+/// has a `base` section) holds only its differences from that file: its
+/// sections are merged into the base's key by key, at every depth (e.g. `arm: {sync_gain_per_s:
+/// 1.0}` over `config/resolver.yaml` changes that one value).
 pub fn load_validated<T: DeserializeOwned>(
     path: &Path,
     validate: impl FnOnce(&T) -> Result<(), InvalidParam>,
 ) -> Result<T, ParamsError> {
     let (text, file) = yaml::read_text(path)?;
-    parse_validated(&text, &file, validate)
+    let layer: serde_json::Value = yaml::parse_str(&text, &file)?;
+    if layer.get(EXTENDS).is_none() {
+        // parsed from the text, so that errors keep their line and column
+        return parse_validated(&text, &file, validate);
+    }
+    let merged = read_layers(path, 0)?;
+    let p: T = serde_json::from_value(merged).map_err(|e| YamlError::Parse { file: file.clone(), line: None, column: None, message: e.to_string() })?;
+    validate(&p).map_err(|param| ParamsError::Invalid { file, param })?;
+    Ok(p)
+}
+
+/// The key naming the file a parameter file derives from.
+const EXTENDS: &str = "extends";
+
+/// How many files a parameter file may derive through (a cycle ends here with an error).
+const MAX_EXTENDS_DEPTH: usize = 8;
+
+/// The file at `path` merged over the files it extends, `depth` files below the one first named.
+fn read_layers(path: &Path, depth: usize) -> Result<serde_json::Value, YamlError> {
+    let (text, file) = yaml::read_text(path)?;
+    let mut layer: serde_json::Map<String, serde_json::Value> = yaml::parse_str(&text, &file)?;
+    let Some(base) = layer.remove(EXTENDS) else {
+        return Ok(serde_json::Value::Object(layer));
+    };
+    let invalid = |message: String| YamlError::Parse { file: file.clone(), line: None, column: None, message: format!("{EXTENDS}: {message}") };
+    let base = base.as_str().ok_or_else(|| invalid("must be a file name".into()))?;
+    if depth >= MAX_EXTENDS_DEPTH {
+        return Err(invalid(format!("more than {MAX_EXTENDS_DEPTH} files deep (a cycle?)")));
+    }
+    let mut merged = read_layers(&path.parent().unwrap_or(Path::new(".")).join(base), depth + 1)?;
+    merge(&mut merged, serde_json::Value::Object(layer));
+    Ok(merged)
+}
+
+/// Merges `layer` into `base`: maps key by key (recursively), any other value replaces.
+fn merge(base: &mut serde_json::Value, layer: serde_json::Value) {
+    match (base, layer) {
+        (serde_json::Value::Object(b), serde_json::Value::Object(l)) => {
+            for (key, value) in l {
+                match b.get_mut(&key) {
+                    Some(slot) => merge(slot, value),
+                    None => {
+                        b.insert(key, value);
+                    }
+                }
+            }
+        }
+        (slot, value) => *slot = value,
+    }
 }
 
 /// All skin model parameters (one YAML file, sections as the fields).
@@ -150,6 +202,30 @@ mod tests {
     fn shipped_params_load() {
         let p = SkinParams::load(&shipped()).expect("shipped skin_model.yaml");
         assert!(p.repulsion.range_m <= p.proximity.range_m);
+    }
+
+    #[test]
+    fn a_file_extends_another_key_by_key() {
+        use crate::resolver::ResolverParams;
+        let config = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../config");
+        let base = ResolverParams::load(&config.join("resolver.yaml")).unwrap();
+        let phases = ResolverParams::load(&config.join("resolver_phases.yaml")).unwrap();
+        assert_ne!(phases.arm.sync_gain_per_s, base.arm.sync_gain_per_s);
+        let mut expected = base.clone();
+        expected.arm.sync_gain_per_s = phases.arm.sync_gain_per_s;
+        assert_eq!(phases, expected);
+
+        let dir = std::env::temp_dir().join(format!("skin_params_extends_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let write = |name: &str, text: &str| std::fs::write(dir.join(name), text).unwrap();
+        write("a.yaml", "extends: b.yaml\n");
+        write("b.yaml", "extends: a.yaml\n");
+        let e = ResolverParams::load(&dir.join("a.yaml")).unwrap_err().to_string();
+        assert!(e.contains("a.yaml") && e.contains("extends") && e.contains("cycle"), "{e}");
+        write("c.yaml", &format!("extends: {}\narm: {{sync_gain_per_s: -1.0}}\n", config.join("resolver.yaml").display()));
+        let e = ResolverParams::load(&dir.join("c.yaml")).unwrap_err().to_string();
+        assert!(e.contains("c.yaml") && e.contains("arm.sync_gain_per_s"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -64,7 +64,8 @@ pub struct GoalMetrics {
     pub goal_error_m: f64,
     /// Goal tolerance of the supervisor \[m\].
     pub goal_tolerance_m: f64,
-    /// Largest physical contact force on one link during intentional contact (Table I (b)) \[N\].
+    /// Largest physical contact force on one link during intentional contact (Table I (b)),
+    /// outside the pushes and their recovery allowance (a push starting in (b) is the push's) \[N\].
     pub max_contact_force_intentional_n: f64,
     /// Largest physical contact force on one link outside the pushes (and their recovery
     /// allowance) \[N\].
@@ -171,7 +172,7 @@ fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: Limits) -> GoalMe
         goal_reached: error <= limits.goal_tolerance_m,
         goal_error_m: error,
         goal_tolerance_m: limits.goal_tolerance_m,
-        max_contact_force_intentional_n: max_force(&|c| c.mode == Mode::IntentionalContact),
+        max_contact_force_intentional_n: max_force(&|c| c.mode == Mode::IntentionalContact && !excused(c.t_s)),
         max_contact_force_n: max_force(&|c| !excused(c.t_s)),
         eps_c_n: eps,
         hard_contact_recovery_s: recovery,

@@ -67,6 +67,9 @@ fn intentional_contact_passes_every_outcome_check() {
         assert!(c.passed, "{}: {}", c.name, c.detail);
     }
     assert!(report.checks.iter().any(|c| c.name == "hard push relieved"), "the push reaches the arm");
+    let g = report.metrics.goal.as_ref().expect("goal metrics");
+    assert!(g.max_contact_force_intentional_n > 0.0, "the arm touches the obstacle in (b)");
+    assert!(g.max_contact_force_intentional_n <= g.eps_c_n, "intentional contact at most eps_c: {} N", g.max_contact_force_intentional_n);
 }
 
 #[test]

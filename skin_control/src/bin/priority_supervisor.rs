@@ -1,5 +1,7 @@
 //! `priority_supervisor`: paper 000 Table I / paper 003 Table 1 on the ROS graph. Wiring in
 //! `skin_control::nodes::priority_supervisor`, work in `skin_control::supervisor_node`.
+use std::time::Duration;
+
 use anyhow::{Context as _, Result};
 use clap::Parser;
 use futures::executor::LocalPool;
@@ -30,6 +32,8 @@ fn main() -> Result<()> {
     let mut pool = LocalPool::new();
     let handle = priority_supervisor::start(&mut node, &pool.spawner(), args.options)?;
     nodes::spin(&mut node, &mut pool, || Pass::Idle);
+    // Nothing delivered is lost on a stop: the dwell timers and the switch log count every state.
+    nodes::drain(&mut node, &mut pool, || handle.states_taken(), Duration::from_secs(2));
     handle.stop();
     Ok(())
 }

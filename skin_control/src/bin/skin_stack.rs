@@ -85,7 +85,7 @@ fn run() -> Result<Option<bool>> {
                 record: args.record.clone(),
                 out: args.out.clone(),
                 controller: args.setup.as_ref().map(PathBuf::from),
-                // the lockstep default: the controller's required inputs
+                // in one process the nodes' subscriptions exist before the first state
                 wait_topic_subscribers: vec![],
             };
             Some(mujoco_sim::start(node, &spawner, options)?)

@@ -139,6 +139,23 @@ pub fn spin(node: &mut r2r::Node, pool: &mut futures::executor::LocalPool, mut p
     spin_nodes(&mut [(node, &mut poll)], pool);
 }
 
+/// After a stop request, takes what was delivered to `node` or is still on its way (a subscriber
+/// can be hundreds of samples behind a lockstep run that goes several times faster than real
+/// time): spins until `taken` (a count of samples handled) has not changed for 100 ms, for at
+/// most `limit`.
+pub fn drain(node: &mut r2r::Node, pool: &mut futures::executor::LocalPool, mut taken: impl FnMut() -> u64, limit: Duration) {
+    let start = std::time::Instant::now();
+    let (mut last, mut last_change) = (taken(), start);
+    while last_change.elapsed() < Duration::from_millis(100) && start.elapsed() < limit {
+        node.spin_once(Duration::from_millis(10));
+        pool.run_until_stalled();
+        let now = taken();
+        if now != last {
+            (last, last_change) = (now, std::time::Instant::now());
+        }
+    }
+}
+
 /// Spins each node, runs `pool` (its tasks take what the node took) and calls the node's poll,
 /// node after node, until SIGINT/SIGTERM or a poll says [`Pass::Done`]. One node waits in its
 /// wait set (woken by its own traffic). Several nodes (r2r has no shared wait set) are polled:

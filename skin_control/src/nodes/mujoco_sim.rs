@@ -61,9 +61,10 @@ pub struct Options {
     #[arg(long, default_value_t = 1.0, value_name = "SECONDS")]
     pub resend: f64,
     /// Lockstep: before the first state, wait (at most 30 s) until TOPIC has N subscribers, e.g.
-    /// `/skin/cells=3` when the controller, the aggregator and a recorder must all get it
-    /// [default: 1 on /joint_states, and on /skin/cells and /base/odom when the scene has a skin
-    /// and a base: the inputs a controller requires].
+    /// `/skin/cells=3` when the controller, the aggregator and a recorder must all get it.
+    /// Without it, a first state sent before discovery completes is lost and sent again after
+    /// `--resend` (waiting only for the inputs' readers is not enough: the controller's command
+    /// and state writers must be matched too).
     #[arg(long, num_args = 1.., value_name = "TOPIC=N", value_parser = crate::rosbag::play::topic_count)]
     pub wait_topic_subscribers: Vec<(String, usize)>,
     /// Command namespaces, one per arm (default: /left_arm /right_arm for TOMM, else /arm).
@@ -135,8 +136,9 @@ pub struct SimHandle {
     sent_at: Option<Instant>,
     next_tick: Instant,
     started: Instant,
-    /// When the first state went out: the run's wall time counts from here (start-up and
-    /// discovery excluded, as skin_sim's in-process runs exclude their set-up).
+    /// When the run's wall time starts: in lockstep the sending of the first state that was
+    /// answered, in real time the first step (start-up and discovery, with the resends of a first
+    /// state lost before it, excluded, as skin_sim's in-process runs exclude their set-up).
     running: Option<Instant>,
     record: Vec<AppliedCommand>,
     periods: u64,
@@ -275,7 +277,7 @@ impl SimHandle {
         Ok(())
     }
 
-    /// Wall time since the first state \[s\] (0 before it).
+    /// Wall time since the run started \[s\] (0 before it).
     fn run_wall_s(&self) -> f64 {
         self.running.map_or(0.0, |r| r.elapsed().as_secs_f64())
     }
@@ -303,10 +305,10 @@ impl SimHandle {
                 self.clear_inbox();
                 self.publish_state()?;
                 self.sent_at = Some(Instant::now());
-                self.running = self.sent_at;
                 return Ok(Pass::Busy);
             };
             if self.take_commands(true) {
+                self.running.get_or_insert(sent);
                 self.advance()?;
                 if self.bridge.world().time() >= self.end_s - 1e-9 {
                     return Ok(Pass::Done);
@@ -352,7 +354,7 @@ impl SimHandle {
         let start_up = self.running.unwrap_or_else(Instant::now) - self.started;
         r2r::log_info!(
             &self.logger,
-            "stopping at t = {sim:.3} s after {} periods ({} resends, {} bad commands); real-time factor {:.2} ({wall:.3} s from the first state, {:.3} s of start-up before it)",
+            "stopping at t = {sim:.3} s after {} periods ({} resends, {} bad commands); real-time factor {:.2} ({wall:.3} s from the first answered state, {:.3} s of start-up before it)",
             self.periods,
             self.resends,
             self.inbox.borrow().errors,
@@ -399,13 +401,6 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
     let bridge = SimBridge::new(scene.clone(), &options.arm_namespaces, &options.arm_prefixes).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
     let recorder = options.out.as_ref().map(|dir| start_recorder(&options, scene, &bridge, dir)).transpose()?;
     let end_s = options.duration.unwrap_or(bridge.duration_s());
-    if options.lockstep && options.wait_topic_subscribers.is_empty() {
-        // A state sent before the controller's readers are matched is lost, and the lockstep
-        // would stall for a `--resend` period.
-        let skin = bridge.world().scene().skin.is_some();
-        let required = [(JOINT_STATES, true), (CELLS, skin), (ODOM, bridge.has_base())];
-        options.wait_topic_subscribers = required.iter().filter(|(_, r)| *r).map(|(t, _)| (t.to_string(), 1)).collect();
-    }
     let pubs = Pubs {
         clock: node.create_publisher(CLOCK, qos::stream())?,
         joints: node.create_publisher(JOINT_STATES, qos::stream())?,

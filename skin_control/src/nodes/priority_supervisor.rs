@@ -38,6 +38,11 @@ pub struct SupervisorHandle {
 }
 
 impl SupervisorHandle {
+    /// Controller states taken so far.
+    pub fn states_taken(&self) -> u64 {
+        self.sup.borrow().updates()
+    }
+
     /// Logs the summary.
     pub fn stop(&self) {
         let s = self.sup.borrow();

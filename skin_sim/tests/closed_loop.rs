@@ -57,19 +57,41 @@ fn intentional_contact_passes_every_outcome_check() {
     // The whole scene (20 s simulated, a few seconds here): paper 000 Figs. 2-3. The arm comes to
     // rest at the obstacle (continuous skin-row activation), enters intentional contact, pushes
     // the obstacle below eps_c, reaches the goal and relieves the hard push within 0.5 s.
-    let report = run("intentional_contact", 20.0);
+    let report = passes_paper_000_checks("intentional_contact", 20.0);
+    assert!(report.checks.iter().any(|c| c.name == "hard push relieved"), "the push reaches the arm");
+}
+
+#[test]
+fn tomm_movable_obstacles_passes_every_outcome_check() {
+    // Paper 000 Fig. 5, the whole scene (30 s): TOMM's right arm stuck at two movable blocks on
+    // the table pushes them aside in intentional contact and reaches the goal.
+    passes_paper_000_checks("tomm_movable_obstacles", 30.0);
+}
+
+#[test]
+fn tomm_fixed_obstacle_passes_every_outcome_check() {
+    // Paper 000 Fig. 6, the whole scene (40 s): beside a fixed wall, the movable block on the path
+    // is pushed away in intentional contact; the goal is reached.
+    passes_paper_000_checks("tomm_fixed_obstacle", 40.0);
+}
+
+/// Runs a paper 000 scene and asserts its story: stuck first ((a) -> (b)), the arm touches the
+/// obstacle in (b) with at most eps_c, and every outcome check (goal within 1 cm, contacts at
+/// most eps_c outside the pushes, pushes relieved) passes.
+fn passes_paper_000_checks(name: &str, seconds: f64) -> skin_sim::report::RunReport {
+    let report = run(name, seconds);
     let modes: Vec<_> = report.record.switches.iter().map(|s| (s.from, s.to)).collect();
     assert!(
         modes.first().is_some_and(|&(a, b)| a == Mode::Avoidance && b == Mode::IntentionalContact),
-        "first switch is the stuck test (a) -> (b): {modes:?}"
+        "{name}: first switch is the stuck test (a) -> (b): {modes:?}"
     );
     for c in &report.checks {
-        assert!(c.passed, "{}: {}", c.name, c.detail);
+        assert!(c.passed, "{name}: {}: {}", c.name, c.detail);
     }
-    assert!(report.checks.iter().any(|c| c.name == "hard push relieved"), "the push reaches the arm");
     let g = report.metrics.goal.as_ref().expect("goal metrics");
-    assert!(g.max_contact_force_intentional_n > 0.0, "the arm touches the obstacle in (b)");
-    assert!(g.max_contact_force_intentional_n <= g.eps_c_n, "intentional contact at most eps_c: {} N", g.max_contact_force_intentional_n);
+    assert!(g.max_contact_force_intentional_n > 0.0, "{name}: the arm touches the obstacle in (b)");
+    assert!(g.max_contact_force_intentional_n <= g.eps_c_n, "{name}: intentional contact at most eps_c: {} N", g.max_contact_force_intentional_n);
+    report
 }
 
 #[test]

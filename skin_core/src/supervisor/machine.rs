@@ -248,8 +248,11 @@ impl Supervisor {
                         self.switch(t, Mode::IntentionalContact, Cause::Stuck);
                     }
                 } else {
-                    let reached = ge <= th.goal_tolerance_m;
                     let clear = fd <= th.obstacle_force_n;
+                    // At rest at the goal with an obstacle still in range is Table I's (b): going
+                    // back to (a) there lets avoidance push the hand off the goal, stuck again,
+                    // (b) again (a cycle seen in the TOMM scenes).
+                    let reached = ge <= th.goal_tolerance_m && clear;
                     // Every timer advances every cycle; then the first that has held wins.
                     let g = self
                         .goal_reached

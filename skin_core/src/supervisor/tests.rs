@@ -158,7 +158,7 @@ fn hard_contact_from_a_returns_to_a() {
 fn goal_reached_or_cleared_b_to_a() {
     let p = params();
     for (u, cause) in [
-        (input(0.0, 3.0, 0.0, 0.005), Cause::GoalReached),
+        (input(0.0, 0.0, 0.0, 0.005), Cause::GoalReached), // wins: shorter dwell
         (input(0.05, 0.0, 0.0, 0.2), Cause::ObstacleCleared),
         (input(f64::NAN, 3.0, 0.0, 0.2), Cause::InvalidInput),
     ] {
@@ -172,6 +172,21 @@ fn goal_reached_or_cleared_b_to_a() {
             (Mode::IntentionalContact, Mode::Avoidance, cause)
         );
     }
+}
+
+/// Table I's (b) holds at rest at the goal while an obstacle is in range (going back to (a)
+/// there would let avoidance push the end effector off the goal, stuck again, (b) again); (a)
+/// follows once the obstacle is out of range.
+#[test]
+fn goal_reached_with_an_obstacle_in_range_stays_in_b() {
+    let p = params();
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    into_b(&mut sup, &mut t);
+    assert!(run(&mut sup, &mut t, 1000, input(0.0, 3.0, 0.0, 0.0)).is_empty());
+    let tr = run(&mut sup, &mut t, 300, input(0.0, 0.0, 0.0, 0.0));
+    assert_eq!(tr.len(), 1, "{tr:?}");
+    assert_eq!((tr[0].to, tr[0].cause), (Mode::Avoidance, Cause::GoalReached));
 }
 
 #[test]
@@ -198,13 +213,13 @@ fn sensing_range_shrinks_gradually_in_b_and_is_restored_in_a() {
     }
     assert_eq!(prev, r.intentional_contact_m);
     assert!(hit_zero_at.is_some());
-    // Goal reached -> (a); the range comes back gradually to nominal.
-    let tr = run(&mut sup, &mut t, 100, input(0.0, 3.0, 0.0, 0.0));
+    // Goal reached, nothing in range -> (a); the range comes back gradually to nominal.
+    let tr = run(&mut sup, &mut t, 100, input(0.0, 0.0, 0.0, 0.0));
     assert_eq!(tr[0].to, Mode::Avoidance);
     prev = sup.arrangement().sensing_range_m;
     for _ in 0..1000 {
         t += DT;
-        let a = sup.update(t, &input(0.0, 3.0, 0.0, 0.0));
+        let a = sup.update(t, &input(0.0, 0.0, 0.0, 0.0));
         let d = a.sensing_range_m - prev;
         assert!((-1e-15..=r.restore_rate_mps * DT + 1e-12).contains(&d));
         prev = a.sensing_range_m;

@@ -31,6 +31,7 @@ pub mod outcome;
 pub mod outputs;
 pub mod plot;
 pub mod probe;
+mod proximity_rays;
 pub mod record;
 pub mod report;
 pub mod runner;

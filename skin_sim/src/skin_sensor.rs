@@ -2,9 +2,10 @@
 //! the three force sensors from the MuJoCo contacts near the cell, both through the cell
 //! characteristics of `config/skin_model.yaml` (paper 003 Sec. 2.3: normalized, nonlinear).
 //!
-//! - Proximity: `mj_ray` from the cell's world position along its outward normal, testing only
-//!   objects and persons ([`SENSED_GROUPS`]: the robot never sees itself); the hit distance goes
-//!   through `p(d)` (0 from the sensor range on). A cell in contact reads 1.
+//! - Proximity: a ray from the cell's world position along its outward normal, testing only
+//!   objects and persons (`crate::mjcf::SENSED_GROUPS`: the robot never sees itself) near the
+//!   ray ([`ProximityRays`]); the hit distance goes through `p(d)` (0 from the sensor range on).
+//!   A cell in contact reads 1.
 //! - Force: the contacts of one robot geom with one other geom give their summed normal force
 //!   (`mj_contactForce`), which the cells of the touched body share in proportion to how deep the
 //!   other geom presses into each cell's face ([`CellFace::compression`]: the soft cover's
@@ -29,8 +30,9 @@ use skin_core::skin::signals::CellReading;
 
 use crate::cell_face::CellFace;
 use crate::frames::{body_pose, FrameRef};
-use crate::mjcf::{ROBOT_GROUP, SENSED_GROUPS};
+use crate::mjcf::ROBOT_GROUP;
 use crate::noise::Noise;
+use crate::proximity_rays::ProximityRays;
 use crate::scene::Scene;
 
 /// One cell in its MuJoCo body's frame.
@@ -65,6 +67,7 @@ pub struct SkinSensor {
     by_body: Vec<usize>,
     body_range: Vec<Range<usize>>,
     proximity: PreparedProximity,
+    rays: ProximityRays,
     force: PreparedForce,
     contact_radius_m: f64,
     proximity_noise_std: f64,
@@ -123,6 +126,7 @@ impl SkinSensor {
             by_body,
             body_range,
             proximity: skin.params.proximity.prepared(),
+            rays: ProximityRays::new(mj, skin.params.proximity.range_m),
             force: skin.params.force.prepared(),
             contact_radius_m: spec.contact_radius_m,
             proximity_noise_std: spec.proximity_noise_std,
@@ -171,12 +175,7 @@ impl SkinSensor {
 
     fn ray_proximity<M: ModelType>(&self, data: &mut MjData<M>, i: usize) -> f64 {
         let (p, n) = self.cell_world(data, i);
-        // flg_static = true: fixed objects and mocap persons are static bodies and must be seen.
-        let (hit, d) = data.ray(&[p.x, p.y, p.z], &[n.x, n.y, n.z], Some(&SENSED_GROUPS), true, None, None);
-        match hit {
-            Some(_) => self.proximity.signal(d),
-            None => 0.0,
-        }
+        self.rays.cast(data, p, n).map_or(0.0, |d| self.proximity.signal(d))
     }
 
     /// Fills `force_n` with each cell's share of the normal contact forces on the robot. MuJoCo

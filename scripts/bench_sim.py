@@ -1,0 +1,49 @@
+#!/usr/bin/env python3
+"""In-process simulation speed of every scenario (issue #5's speed report).
+
+Usage: bench_sim.py RELEASE_DIR SUMMARY_JSON
+
+Runs `skin_sim run <name> --out DIR` (release build, the whole scene at its own rates) for every
+scenario of `skin_sim list` and merges into SUMMARY_JSON (created if missing):
+- sim_realtime_factor_planar: intentional_contact (the planar arm of paper 000);
+- sim_realtime_factor_tomm: the slowest of the TOMM scenarios (paper 000 Figs. 5-6, paper 003);
+- sim_realtime_factor_<name>: each scenario.
+The factor is simulated time over the wall time of the loop (set-up and output writing excluded),
+as skin_sim's metrics.json reports it. Runs are sequential; one line of progress per scenario.
+"""
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+PLANAR = "intentional_contact"
+
+
+def main() -> int:
+    if len(sys.argv) != 3:
+        print(__doc__, file=sys.stderr)
+        return 2
+    sim, out = Path(sys.argv[1]) / "skin_sim", Path(sys.argv[2])
+    names = [line.split()[0] for line in subprocess.run([sim, "list"], check=True, capture_output=True,
+                                                         text=True).stdout.splitlines() if line.strip()]
+    figures = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for k, name in enumerate(names, 1):
+            run = subprocess.run([sim, "run", name, "--out", f"{tmp}/{name}"], capture_output=True, text=True)
+            if run.returncode not in (0, 1):  # 1: an outcome check failed, the speed still counts
+                print(run.stdout[-2000:], run.stderr[-2000:], file=sys.stderr)
+                raise SystemExit(f"bench_sim: skin_sim run {name} exited with {run.returncode}")
+            rtf = json.loads(Path(f"{tmp}/{name}/metrics.json").read_text())["realtime_factor"]
+            figures[f"sim_realtime_factor_{name}"] = round(rtf, 2)
+            print(f"[bench] sim {k}/{len(names)} {name}: realtime factor {rtf:.1f}", flush=True)
+    figures["sim_realtime_factor_planar"] = figures[f"sim_realtime_factor_{PLANAR}"]
+    figures["sim_realtime_factor_tomm"] = min(v for k, v in figures.items() if not k.endswith(PLANAR))
+    summary = json.loads(out.read_text()) if out.is_file() else {}
+    summary.update(figures)
+    out.write_text(json.dumps(summary, indent=2, sort_keys=True) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -53,6 +53,19 @@ pub struct Metrics {
     /// Paper 003 figures (scenes with force references).
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub force: Option<ForceMetrics>,
+    /// Scenes with neither goals nor force references (paper 003 Exp. 2's pre-contact approach
+    /// and guidance): nothing of the robot may press on the environment.
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub contact_free: Option<ContactFreeMetrics>,
+}
+
+/// A scene in which the robot should touch nothing: its largest contact against `ε_c`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ContactFreeMetrics {
+    /// Largest physical contact force of the environment on one robot link, whole run \[N\].
+    pub max_link_contact_n: f64,
+    /// `ε_c` of the supervisor \[N\].
+    pub eps_c_n: f64,
 }
 
 /// Paper 000: the goal and the contact forces against `ε_c`.
@@ -143,6 +156,10 @@ pub fn compute(record: &RunRecord, scene: &Scene, limits: Limits) -> Metrics {
         faulted_cycles: cycles.iter().filter(|c| c.fault.is_some()).count(),
         goal: (!scene.spec.goals.is_empty()).then(|| goal_metrics(cycles, scene, limits)),
         force: (!scene.spec.force_references.is_empty()).then(|| force_metrics(cycles)),
+        contact_free: (scene.spec.goals.is_empty() && scene.spec.force_references.is_empty()).then(|| ContactFreeMetrics {
+            max_link_contact_n: cycles.iter().map(|c| c.link_force_n).fold(0.0, f64::max),
+            eps_c_n: limits.eps_c_n,
+        }),
     }
 }
 

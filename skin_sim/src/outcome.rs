@@ -26,7 +26,8 @@ fn at_most(name: &'static str, value: f64, limit: f64, unit: &str) -> Check {
 
 /// The checks of a run: no faulted cycle; paper 000 scenes: goal reached, every contact at most
 /// `ε_c` outside the pushes, pushes relieved within [`RECOVERY_LIMIT_S`]; paper 003 scenes with
-/// `targets`: the RMS force errors of Table 3.
+/// `targets`: the RMS force errors of Table 3; scenes with neither goals nor force references:
+/// no link contact above `ε_c`.
 pub fn checks(m: &Metrics, targets: Option<ForceTargets>) -> Vec<Check> {
     let mut out = vec![Check {
         name: "no safe-stop cycles",
@@ -39,6 +40,9 @@ pub fn checks(m: &Metrics, targets: Option<ForceTargets>) -> Vec<Check> {
         if !g.hard_contact_recovery_s.is_nan() {
             out.push(at_most("hard push relieved", g.hard_contact_recovery_s, RECOVERY_LIMIT_S, "s"));
         }
+    }
+    if let Some(c) = &m.contact_free {
+        out.push(at_most("no link presses on anything (<= eps_c)", c.max_link_contact_n, c.eps_c_n, "N"));
     }
     if let (Some(f), Some(t)) = (&m.force, targets) {
         out.push(at_most("RMS force error w/o interaction", f.rms_force_error_n, t.rms_without_n, "N"));

@@ -19,7 +19,7 @@ use crate::report::{MetricsJson, RunOutput, RunReport, SummaryText};
 pub const ALL: [&dyn RunOutput; 4] = [&MetricsJson, &SummaryText, &FigurePng, &RunBag];
 
 /// `figure.png`: paper 000's panels (arrangement, ee speed, proximity and contact force, torque)
-/// for a paper 000 scenario, paper 003's force-tracking panels for a force scenario.
+/// for a paper 000 scenario, paper 003's force-tracking panels for a scene of paper 003's phases.
 pub struct FigurePng;
 
 fn column(cycles: &[CycleRecord], f: impl Fn(&CycleRecord) -> f64) -> Vec<f64> {
@@ -36,7 +36,9 @@ impl RunOutput for FigurePng {
         let interactions = intervals_where(&t, &interaction);
         let scene = Path::new(&r.scene_file).file_name().map_or_else(|| r.scene_file.clone(), |f| f.to_string_lossy().into_owned());
         let title = format!("{} (seed {}, {})", r.name, r.seed, scene);
-        let figure = if report.metrics.force.is_some() {
+        // Paper 003's phases (force tracking or the pre-contact approach) or paper 000's Table I.
+        let phases = c.iter().any(|c| matches!(c.mode, Mode::PreContact | Mode::Contact));
+        let figure = if phases {
             let phase: Vec<usize> = c.iter().map(|c| usize::from(c.mode == Mode::Contact)).collect();
             let base_speed = column(c, |c| c.base_twist[0].hypot(c.base_twist[1]));
             paper003_figure(
@@ -49,7 +51,7 @@ impl RunOutput for FigurePng {
                     fusion_weight: &column(c, |c| c.fusion_weight),
                     base_speed: &base_speed,
                     tactile: &[],
-                    base_avoidance: &interactions,
+                    interaction: &interactions,
                 },
             )
         } else {

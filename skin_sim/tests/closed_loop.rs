@@ -32,7 +32,8 @@ fn metrics_json_has_the_keys_of_each_paper() {
     let always = ["realtime_factor", "sim_duration_s", "max_joint_speed_rad_s", "control_cycle_us_p50", "arrangement_switches"];
     let paper000 = ["goal_reached", "goal_error_m", "max_contact_force_intentional_n", "eps_c_n", "hard_contact_recovery_s"];
     let paper003 = ["force_mean_n", "rms_force_error_n", "rms_force_error_interaction_n"];
-    for (name, keys) in [("intentional_contact", &paper000[..]), ("poster_phrc", &paper003[..])] {
+    let contact_free = ["max_link_contact_n", "eps_c_n"];
+    for (name, keys) in [("intentional_contact", &paper000[..]), ("poster_phrc", &paper003[..]), ("tactile_guidance", &contact_free[..])] {
         let report = run(name, 0.5);
         let json: serde_json::Value = serde_json::to_value(&report.metrics).unwrap();
         for key in always.iter().chain(keys) {

@@ -86,8 +86,9 @@ pub struct Paper003Signals<'a> {
     pub base_speed: &'a [f64],
     /// Tactile guidance periods `(start, end)` \[s\] (green in the paper).
     pub tactile: &'a [(f64, f64)],
-    /// Mobile-base collision avoidance periods `(start, end)` \[s\] (red in the paper).
-    pub base_avoidance: &'a [(f64, f64)],
+    /// Scripted interaction periods `(start, end)` \[s\]: touches on the arm, a person near the
+    /// base (red, as the paper marks base collision avoidance).
+    pub interaction: &'a [(f64, f64)],
 }
 
 /// Paper 003's figure: (a) desired and measured hand force, (b) force error with its RMS over
@@ -138,8 +139,8 @@ pub fn paper003_figure(title: &str, s: &Paper003Signals) -> Figure {
     for &(a, b) in s.tactile {
         fig = fig.shade(a, b, "tactile guidance", Tint::Green);
     }
-    for &(a, b) in s.base_avoidance {
-        fig = fig.shade(a, b, "base collision avoidance", Tint::Red);
+    for &(a, b) in s.interaction {
+        fig = fig.shade(a, b, "interaction (touch, person)", Tint::Red);
     }
     fig
 }

@@ -139,7 +139,7 @@ fn paper003_layout_reports_the_contact_rms_error() {
             fusion_weight: &w,
             base_speed: &base,
             tactile: &[(4.0, 5.0)],
-            base_avoidance: &[(6.0, 7.5)],
+            interaction: &[(6.0, 7.5)],
         },
     );
     assert!(

@@ -1,8 +1,10 @@
 """The launch files name only things that exist. No launch runtime is installed here, so each file
 is parsed (ast): every `executable=` of a skin_control Node must be a skin_control binary
 (skin_control/src/bin/<name>.rs), and every file the launch files name through `share(...)` or a
-path default (config/..., urdf/...) must exist in the package."""
+path default (config/..., urdf/...) must exist in the package and be installed to its share
+directory on a colcon build (skin_control/Cargo.toml's `install_to_share`)."""
 import ast
+import tomllib
 
 import pytest
 
@@ -40,6 +42,20 @@ def test_launch_file_names_existing_things(path):
     assert files, f"{path.name}: names no files"
     for (f,) in files:
         assert (TOP / f).is_file(), f"{path.name}: {f} does not exist"
+
+
+def test_the_colcon_install_puts_what_the_launch_files_name_into_share():
+    # cargo-ament-build copies each entry to share/<package>/<its last path component>.
+    manifest = tomllib.loads((TOP / "skin_control" / "Cargo.toml").read_text())
+    entries = manifest["package"]["metadata"]["ros"]["install_to_share"]
+    installed = {(TOP / "skin_control" / e).resolve().relative_to(TOP).as_posix(): e.rsplit("/", 1)[-1] for e in entries}
+    assert installed.get("launch") == "launch", "the launch files themselves (ros2 launch skin_control ...)"
+    for path in LAUNCH:
+        tree = ast.parse(path.read_text(), filename=str(path))
+        for c in calls(tree, "share"):
+            parts = [const(a) for a in c.args]
+            if parts and parts[0]:
+                assert installed.get(parts[0]) == parts[0], f"{path.name}: share({parts[0]!r}, ...) is not installed to share"
 
 
 def test_sim_launch_covers_the_graph():

@@ -552,6 +552,13 @@ cells:
         assert_eq!(r.cells()[1].id, 12);
         assert_eq!(r.cell_index(11), Some(2));
         assert_eq!(r.cell_index(99), None);
+        assert_eq!(r.cell_index(u32::MAX), None);
+        // Sparse ids (a table would be huge): the same answers by binary search.
+        let sparse = GOOD.replace("id: 11,", "id: 4000000000,");
+        let r = SkinLayout::from_yaml_str(&sparse, "sparse.yaml").unwrap().resolve_with(lookup).unwrap();
+        assert_eq!(r.cell_index(4_000_000_000), Some(2));
+        assert_eq!(r.cell_index(10), Some(0));
+        assert_eq!(r.cell_index(11), None);
         // Normal normalized; patch rotated by +90 deg about z and shifted by 0.1 in z.
         let c = &r.cells()[0];
         assert_relative_eq!(c.normal_patch, Vector3::x(), epsilon = 1e-12);

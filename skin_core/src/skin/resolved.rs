@@ -66,6 +66,44 @@ pub(crate) struct LinkCellGeometry {
     pub(crate) normal: Vector3<f64>,
 }
 
+/// Cell id -> index into [`ResolvedLayout::cells`]. Every cell of every `/skin/cells` message is
+/// looked up, so ids numbered densely (a skin's cells are 1..n) get a table indexed by id;
+/// sparse ids (a table would be large) keep the sorted pairs and a binary search.
+#[derive(Debug, Clone, PartialEq)]
+enum IdIndex {
+    /// `table[id]` is the index, `u32::MAX` where no cell has that id.
+    Dense(Vec<u32>),
+    /// `(id, index)` sorted by id.
+    Sorted(Vec<(u32, usize)>),
+}
+
+impl IdIndex {
+    /// Ids up to this many per cell (plus a margin) get a table.
+    const DENSE_IDS_PER_CELL: usize = 8;
+
+    fn new(cells: &[ResolvedCell]) -> Self {
+        let max = cells.iter().map(|c| c.id as usize).max().unwrap_or(0);
+        if max < Self::DENSE_IDS_PER_CELL * cells.len() + 1024 && cells.len() < u32::MAX as usize {
+            let mut table = vec![u32::MAX; max + 1];
+            for (i, c) in cells.iter().enumerate() {
+                table[c.id as usize] = i as u32;
+            }
+            IdIndex::Dense(table)
+        } else {
+            let mut ids: Vec<(u32, usize)> = cells.iter().enumerate().map(|(i, c)| (c.id, i)).collect();
+            ids.sort_unstable();
+            IdIndex::Sorted(ids)
+        }
+    }
+
+    fn get(&self, id: u32) -> Option<usize> {
+        match self {
+            IdIndex::Dense(table) => table.get(id as usize).filter(|&&i| i != u32::MAX).map(|&i| i as usize),
+            IdIndex::Sorted(ids) => ids.binary_search_by_key(&id, |&(i, _)| i).ok().map(|k| ids[k].1),
+        }
+    }
+}
+
 /// A validated layout resolved against a robot model; cells are grouped by patch. Immutable:
 /// read through the accessors.
 #[derive(Debug, Clone, PartialEq)]
@@ -73,7 +111,7 @@ pub struct ResolvedLayout {
     source: String,
     patches: Vec<ResolvedPatch>,
     cells: Vec<ResolvedCell>,
-    ids: Vec<(u32, usize)>,
+    ids: IdIndex,
     pub(crate) patch_geometry: Vec<PatchCellGeometry>,
     pub(crate) link_geometry: Vec<LinkCellGeometry>,
 }
@@ -84,8 +122,7 @@ impl ResolvedLayout {
         patches: Vec<ResolvedPatch>,
         cells: Vec<ResolvedCell>,
     ) -> Self {
-        let mut ids: Vec<(u32, usize)> = cells.iter().enumerate().map(|(i, c)| (c.id, i)).collect();
-        ids.sort_unstable();
+        let ids = IdIndex::new(&cells);
         let patch_geometry = cells
             .iter()
             .map(|c| PatchCellGeometry {
@@ -130,10 +167,7 @@ impl ResolvedLayout {
 
     /// Index into [`Self::cells`] of the cell with id `id`.
     pub fn cell_index(&self, id: u32) -> Option<usize> {
-        self.ids
-            .binary_search_by_key(&id, |&(i, _)| i)
-            .ok()
-            .map(|k| self.ids[k].1)
+        self.ids.get(id)
     }
 
     /// Index into [`Self::patches`] of the patch with id `id`.

@@ -6,7 +6,7 @@ use nalgebra::{DMatrix, DVector};
 use crate::model::{bias_forces, crba, ModelData, RobotModel};
 
 use super::dense::{
-    add_mul_vec, axpy, dot, mul, mul_padded, mul_tn, mul_tr_vec, mul_vec, mul_vec_padded, norm, pad, padded_len, set_identity_padded,
+    add_mul_vec, axpy, dot, mul, mul_padded, mul_tn, mul_tr_vec, mul_vec, mul_vec2_padded, mul_vec_padded, norm, pad, padded_len, set_identity_padded,
     sub_mul_nt, sub_outer_padded, unpad,
 };
 use super::inverse::{cholesky, damped_inverse, spd_inverse_padded, symmetric_eigen, InverseParams};
@@ -457,10 +457,12 @@ impl HierarchySolver {
             // j̄ᵀ = N j_iᵀ (jb), M⁻¹ j̄ᵀ (mj), N j̄ᵀ (nj)
             if *first {
                 jb[..n].copy_from_slice(row);
+                mul_vec_padded(&self.minv_pad, jb, mj, ld, n);
+                nj.copy_from_slice(jb);
             } else {
                 mul_vec_padded(&self.nproj_pad, row, jb, ld, n);
+                mul_vec2_padded(&self.minv_pad, &self.nproj_pad, jb, mj, nj, ld, n);
             }
-            mul_vec_padded(&self.minv_pad, jb, mj, ld, n);
             let e = dot(&jb[..n], &mj[..n]);
             let f = self.params.filter(e, self.params.threshold(e));
             if f <= 0.0 {
@@ -471,11 +473,6 @@ impl HierarchySolver {
             diag.damped += usize::from(e < self.params.damping);
             if a <= 0.0 {
                 continue;
-            }
-            if *first {
-                nj.copy_from_slice(jb);
-            } else {
-                mul_vec_padded(&self.nproj_pad, jb, nj, ld, n);
             }
             for x in mj[..n].iter_mut() {
                 *x *= a * f;

@@ -174,7 +174,8 @@ fn mul_vec_pass<const S: usize, const G: usize>(a: &[&[f64]; S], x: &[&[f64]; S]
 }
 
 avx2_dispatch! {
-    /// `a (ld × q) -= u (ld) · vᵀ (q)`, `a` and `u` padded (the rank-one case of [`sub_mul_nt`]).
+    /// `a (ld × q) -= u (ld) · vᵀ (q)` (the rank-one case of [`sub_mul_nt`]; columns skipped
+    /// where `v` is 0), usually on padded `a` and `u`.
     sub_outer_padded => sub_outer_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], ld: usize, q: usize)
 }
 

@@ -61,7 +61,9 @@ pub struct HierarchySolver {
     max_levels: usize,
     max_rows: usize,
     params: InverseParams,
+    /// `L` of `M = L Lᵀ` (also padded: `chol_pad`) and `L⁻¹`, n × n.
     chol: Vec<f64>,
+    chol_pad: Vec<f64>,
     linv: Vec<f64>,
     minv: DMatrix<f64>,
     /// N_L of the last solve (copied from `nproj_pad`).
@@ -111,6 +113,7 @@ impl HierarchySolver {
             max_rows,
             params,
             chol: vec![0.0; n * n],
+            chol_pad: vec![0.0; ld * n],
             linv: vec![0.0; n * n],
             minv: DMatrix::zeros(n, n),
             nproj: DMatrix::identity(n, n),
@@ -206,8 +209,9 @@ impl HierarchySolver {
         self.check_inputs(mass_matrix, posture, bias, tau_out)?;
         let levels = levels.into_iter();
 
-        cholesky(mass_matrix.as_slice(), &mut self.chol, n)?;
-        spd_inverse_padded(&self.chol, &mut self.linv, &mut self.z, &mut self.minv_pad, n, ld);
+        cholesky(mass_matrix.as_slice(), &mut self.chol_pad, n, ld)?;
+        unpad(&self.chol_pad, &mut self.chol, n, ld, n);
+        spd_inverse_padded(&self.chol_pad, &mut self.linv, &mut self.z, &mut self.minv_pad, n, ld);
         unpad(&self.minv_pad, self.minv.as_mut_slice(), n, ld, n);
         set_identity_padded(&mut self.nproj_pad, n, ld);
         self.tau_sum.fill(0.0);

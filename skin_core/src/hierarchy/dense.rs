@@ -192,6 +192,50 @@ fn sub_outer_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], ld: usize, q: us
 }
 
 avx2_dispatch! {
+    /// [`sub_outer_padded`], then `y (ld) = a · x (q)` with the updated `a`, in one pass over
+    /// `a`: the same operations, in the same order, as the two calls one after the other.
+    sub_outer_mul_vec_padded => sub_outer_mul_vec_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], x: &[f64], y: &mut [f64], ld: usize, q: usize)
+}
+
+#[inline(always)]
+fn sub_outer_mul_vec_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], x: &[f64], y: &mut [f64], ld: usize, q: usize) {
+    const PASS: usize = 2;
+    let blocks = ld / BLOCK;
+    let mut b = 0;
+    while b + PASS <= blocks {
+        sub_outer_mul_vec_pass::<PASS>(a, u, v, x, y, ld, q, b);
+        b += PASS;
+    }
+    if b < blocks {
+        sub_outer_mul_vec_pass::<1>(a, u, v, x, y, ld, q, b);
+    }
+}
+
+/// Rows `b0 · BLOCK ..< (b0 + G) · BLOCK` of [`sub_outer_mul_vec_padded`].
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn sub_outer_mul_vec_pass<const G: usize>(a: &mut [f64], u: &[f64], v: &[f64], x: &[f64], y: &mut [f64], ld: usize, q: usize, b0: usize) {
+    let mut acc = [[0.0; BLOCK]; G];
+    let u = &u[b0 * BLOCK..(b0 + G) * BLOCK];
+    for ((col, &vk), &xk) in a[..ld * q].chunks_exact_mut(ld).zip(&v[..q]).zip(&x[..q]) {
+        let col = &mut col[b0 * BLOCK..(b0 + G) * BLOCK];
+        for ((acc, cb), ub) in acc.iter_mut().zip(col.chunks_exact_mut(BLOCK)).zip(u.chunks_exact(BLOCK)) {
+            if vk != 0.0 {
+                for (c, x) in cb.iter_mut().zip(ub) {
+                    *c -= vk * x;
+                }
+            }
+            for (t, c) in acc.iter_mut().zip(cb.iter()) {
+                *t += c * xk;
+            }
+        }
+    }
+    for (g, acc) in acc.iter().enumerate() {
+        y[(b0 + g) * BLOCK..(b0 + g + 1) * BLOCK].copy_from_slice(acc);
+    }
+}
+
+avx2_dispatch! {
     /// `c (ld × p) = a (ld × q) · b (q × p)`, `a` and `c` padded: [`mul_vec_padded`] per column.
     mul_padded => mul_padded_kernel(a: &[f64], b: &[f64], c: &mut [f64], ld: usize, q: usize, p: usize)
 }

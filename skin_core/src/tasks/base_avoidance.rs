@@ -175,20 +175,24 @@ mod tests {
     use super::*;
     use crate::tasks::params::BaseAvoidanceParams;
 
+    fn with_sectors(n: usize) -> BaseAvoidance {
+        let params = BaseAvoidanceParams {
+            f_max_n: 1.0,
+            alpha_m: 0.1,
+            range_m: 1.0,
+            footprint_x_m: [-0.1, 0.1],
+            footprint_y_m: [-0.1, 0.1],
+            sectors: n,
+        };
+        BaseAvoidance::new(3, [0, 1, 2], params).unwrap()
+    }
+
     /// The pseudo-angle binning equals the `atan2` definition of the sectors, with or without a
     /// hint.
     #[test]
     fn sectors_match_atan2() {
         for n in [1, 2, 3, 8, 13] {
-            let params = BaseAvoidanceParams {
-                f_max_n: 1.0,
-                alpha_m: 0.1,
-                range_m: 1.0,
-                footprint_x_m: [-0.1, 0.1],
-                footprint_y_m: [-0.1, 0.1],
-                sectors: n,
-            };
-            let b = BaseAvoidance::new(3, [0, 1, 2], params).unwrap();
+            let b = with_sectors(n);
             for k in 0..3600 {
                 let a = (k as f64 + 0.37) * std::f64::consts::TAU / 3600.0;
                 let p = Vector2::new(a.cos(), a.sin()) * (0.5 + (k % 7) as f64);
@@ -207,15 +211,7 @@ mod tests {
     #[test]
     fn hint_agrees_on_bounds() {
         for n in [2, 4, 8, 13, 360] {
-            let params = BaseAvoidanceParams {
-                f_max_n: 1.0,
-                alpha_m: 0.1,
-                range_m: 1.0,
-                footprint_x_m: [-0.1, 0.1],
-                footprint_y_m: [-0.1, 0.1],
-                sectors: n,
-            };
-            let b = BaseAvoidance::new(3, [0, 1, 2], params).unwrap();
+            let b = with_sectors(n);
             for k in 0..n {
                 for da in [-1e-15, -1e-12, 0.0, 1e-12, 1e-15] {
                     let (s, c) = (std::f64::consts::TAU * k as f64 / n as f64 + da).sin_cos();

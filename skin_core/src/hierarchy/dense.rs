@@ -89,27 +89,6 @@ pub(crate) fn padded_len(n: usize) -> usize {
     n.div_ceil(BLOCK) * BLOCK
 }
 
-/// Defines `pub(crate) fn $name` calling `$kernel` compiled for AVX2 when the CPU has it (4
-/// doubles per instruction instead of SSE2's 2; the same operations in the same order, so the
-/// same results: Rust never fuses a multiply and an add by itself), else as compiled.
-macro_rules! avx2_dispatch {
-    ($(#[$doc:meta])* $name:ident => $kernel:ident($($arg:ident: $ty:ty),*)) => {
-        $(#[$doc])*
-        pub(crate) fn $name($($arg: $ty),*) {
-            #[cfg(target_arch = "x86_64")]
-            if std::arch::is_x86_feature_detected!("avx2") {
-                #[target_feature(enable = "avx2")]
-                unsafe fn avx2($($arg: $ty),*) {
-                    $kernel($($arg),*)
-                }
-                // SAFETY: the CPU supports AVX2 (checked above).
-                return unsafe { avx2($($arg),*) };
-            }
-            $kernel($($arg),*)
-        }
-    };
-}
-
 avx2_dispatch! {
     /// `y (ld) = a (ld × q) · x (q)`, `a` padded: each row is summed in registers over all
     /// columns (the same sum, in the same order, as [`mul_vec`]).
@@ -180,7 +159,7 @@ avx2_dispatch! {
 }
 
 #[inline(always)]
-fn sub_outer_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], ld: usize, q: usize) {
+pub(crate) fn sub_outer_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], ld: usize, q: usize) {
     let u = &u[..ld];
     for (col, &vk) in a[..ld * q].chunks_exact_mut(ld).zip(&v[..q]) {
         if vk != 0.0 {

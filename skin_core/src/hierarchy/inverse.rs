@@ -8,6 +8,7 @@
 //!   reduction + implicit QL; nalgebra's `SymmetricEigen` does the same but allocates) and every
 //!   eigenvalue is inverted by the filter [`InverseParams::filter`].
 
+use super::dense::sub_outer_padded_kernel;
 use super::HierarchyError;
 
 /// Parameters of the damped, rank-aware inverse of `A = J̄ M⁻¹ J̄ᵀ` (paper 003 eq. 23, 25).
@@ -91,15 +92,20 @@ pub(crate) struct InverseInfo {
     pub(crate) min_kept: f64,
 }
 
-/// Cholesky `M = L Lᵀ` of the SPD `m` (n × n, column-major, lower triangle read) into `l`
-/// (ld × n, ld ≥ n: lower triangle written, upper and rows n.. zeroed). Fails on a pivot that is
-/// not clearly positive.
-///
-/// Right-looking: once column k is final, `L[i, c] −= L[c, k] L[i, k]` (i ≥ c) in every later
-/// column c. Each entry gets `M[i, c] − Σ_{k<c} L[c, k] L[i, k]` subtracted in the order of k, as
-/// a left-looking column-by-column pass would, but the later columns' updates are independent of
-/// each other instead of one dependent chain per column.
-pub(crate) fn cholesky(m: &[f64], l: &mut [f64], n: usize, ld: usize) -> Result<(), HierarchyError> {
+avx2_dispatch! {
+    /// Cholesky `M = L Lᵀ` of the SPD `m` (n × n, column-major, lower triangle read) into `l`
+    /// (ld × n, ld ≥ n: lower triangle written, upper and rows n.. zeroed). Fails on a pivot that is
+    /// not clearly positive.
+    ///
+    /// Right-looking: once column k is final, `L[i, c] −= L[c, k] L[i, k]` (i ≥ c) in every later
+    /// column c. Each entry gets `M[i, c] − Σ_{k<c} L[c, k] L[i, k]` subtracted in the order of k, as
+    /// a left-looking column-by-column pass would, but the later columns' updates are independent of
+    /// each other instead of one dependent chain per column.
+    cholesky => cholesky_kernel(m: &[f64], l: &mut [f64], n: usize, ld: usize) -> Result<(), HierarchyError>
+}
+
+#[inline(always)]
+fn cholesky_kernel(m: &[f64], l: &mut [f64], n: usize, ld: usize) -> Result<(), HierarchyError> {
     super::dense::pad(m, l, n, ld, n);
     for k in 0..n {
         let (done, later) = l[..ld * n].split_at_mut((k + 1) * ld);
@@ -117,7 +123,7 @@ pub(crate) fn cholesky(m: &[f64], l: &mut [f64], n: usize, ld: usize) -> Result<
             *x *= inv;
         }
         // whole columns: rows below c as described, rows up to c (zeroed at their turn) too
-        super::dense::sub_outer_padded(later, col, &col[k + 1..n], ld, n - k - 1);
+        sub_outer_padded_kernel(later, col, &col[k + 1..n], ld, n - k - 1);
     }
     Ok(())
 }
@@ -137,12 +143,17 @@ pub(crate) fn spd_inverse_from_cholesky(l: &[f64], linv: &mut [f64], minv: &mut 
     }
 }
 
-/// [`spd_inverse_from_cholesky`] from the padded factor `l` (ld × n) into the padded `minv`
-/// (ld × n, `dense::padded_len`): the same sums `Σ_k L⁻¹_ki L⁻¹_kj` in the same order, as
-/// rank-one updates with the rows `r_k` of `L⁻¹` (nonzero up to column k) down padded columns
-/// instead of n² short dot products. `rows` (ld × n) receives the rows as padded columns,
-/// `linv` (n × n) `L⁻¹`.
-pub(crate) fn spd_inverse_padded(l: &[f64], linv: &mut [f64], rows: &mut [f64], minv: &mut [f64], n: usize, ld: usize) {
+avx2_dispatch! {
+    /// [`spd_inverse_from_cholesky`] from the padded factor `l` (ld × n) into the padded `minv`
+    /// (ld × n, `dense::padded_len`): the same sums `Σ_k L⁻¹_ki L⁻¹_kj` in the same order, as
+    /// rank-one updates with the rows `r_k` of `L⁻¹` (nonzero up to column k) down padded columns
+    /// instead of n² short dot products. `rows` (ld × n) receives the rows as padded columns,
+    /// `linv` (n × n) `L⁻¹`.
+    spd_inverse_padded => spd_inverse_padded_kernel(l: &[f64], linv: &mut [f64], rows: &mut [f64], minv: &mut [f64], n: usize, ld: usize)
+}
+
+#[inline(always)]
+fn spd_inverse_padded_kernel(l: &[f64], linv: &mut [f64], rows: &mut [f64], minv: &mut [f64], n: usize, ld: usize) {
     lower_inverse_rows(l, ld, rows, n, ld);
     for (k, rk) in rows[..ld * n].chunks_exact(ld).enumerate() {
         for (j, x) in rk[..n].iter().enumerate() {
@@ -152,7 +163,7 @@ pub(crate) fn spd_inverse_padded(l: &[f64], linv: &mut [f64], rows: &mut [f64], 
     // −M⁻¹ = −Σ_k r_k r_kᵀ (the columns j ≤ k that r_k reaches), then negated: exact
     minv[..ld * n].fill(0.0);
     for (k, rk) in rows[..ld * n].chunks_exact(ld).enumerate() {
-        super::dense::sub_outer_padded(&mut minv[..ld * (k + 1)], rk, &rk[..=k], ld, k + 1);
+        sub_outer_padded_kernel(&mut minv[..ld * (k + 1)], rk, &rk[..=k], ld, k + 1);
     }
     for x in &mut minv[..ld * n] {
         *x = -*x;
@@ -170,6 +181,7 @@ pub(crate) fn spd_inverse_padded(l: &[f64], linv: &mut [f64], rows: &mut [f64], 
 /// Every entry sees the same operations, in the same order, as a substitution column by column
 /// (plus subtractions of `L[i, k] · 0` that change nothing), but the k-th step's updates are
 /// independent of each other (no chain of divisions per column), and run down whole columns.
+#[inline(always)]
 fn lower_inverse_rows(l: &[f64], ldl: usize, rows: &mut [f64], n: usize, ld: usize) {
     super::dense::set_identity_padded(rows, n, ld);
     for k in 0..n {
@@ -180,7 +192,7 @@ fn lower_inverse_rows(l: &[f64], ldl: usize, rows: &mut [f64], n: usize, ld: usi
         for x in rk.iter_mut() {
             *x /= lk[k];
         }
-        super::dense::sub_outer_padded(later, rk, &lk[k + 1..], ld, n - k - 1);
+        sub_outer_padded_kernel(later, rk, &lk[k + 1..], ld, n - k - 1);
     }
 }
 

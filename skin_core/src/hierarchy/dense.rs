@@ -89,54 +89,77 @@ pub(crate) fn padded_len(n: usize) -> usize {
     n.div_ceil(BLOCK) * BLOCK
 }
 
-/// Defines `pub(crate) fn $name` calling `$kernel` compiled for AVX2 when the CPU has it (4
-/// doubles per instruction instead of SSE2's 2; the same operations in the same order, so the
-/// same results: Rust never fuses a multiply and an add by itself), else as compiled.
-macro_rules! avx2_dispatch {
-    ($(#[$doc:meta])* $name:ident => $kernel:ident($($arg:ident: $ty:ty),*)) => {
-        $(#[$doc])*
-        pub(crate) fn $name($($arg: $ty),*) {
-            #[cfg(target_arch = "x86_64")]
-            if std::arch::is_x86_feature_detected!("avx2") {
-                #[target_feature(enable = "avx2")]
-                unsafe fn avx2($($arg: $ty),*) {
-                    $kernel($($arg),*)
-                }
-                // SAFETY: the CPU supports AVX2 (checked above).
-                return unsafe { avx2($($arg),*) };
-            }
-            $kernel($($arg),*)
-        }
-    };
-}
-
 avx2_dispatch! {
-    /// `y (ld) = a (ld × q) · x (q)`, `a` padded: each block of `BLOCK` rows is summed in
-    /// registers over all columns (the same sum, in the same order, as [`mul_vec`]).
+    /// `y (ld) = a (ld × q) · x (q)`, `a` padded: each row is summed in registers over all
+    /// columns (the same sum, in the same order, as [`mul_vec`]).
     mul_vec_padded => mul_vec_padded_kernel(a: &[f64], x: &[f64], y: &mut [f64], ld: usize, q: usize)
 }
 
 #[inline(always)]
 fn mul_vec_padded_kernel(a: &[f64], x: &[f64], y: &mut [f64], ld: usize, q: usize) {
-    for (b, yb) in y[..ld].chunks_exact_mut(BLOCK).enumerate() {
-        let mut acc = [0.0; BLOCK];
-        for (col, &xk) in a[..ld * q].chunks_exact(ld).zip(&x[..q]) {
-            let ab: &[f64; BLOCK] = col[b * BLOCK..(b + 1) * BLOCK].try_into().unwrap();
-            for (s, aik) in acc.iter_mut().zip(ab) {
-                *s += aik * xk;
+    mul_vec_streams([a], [x], [y], ld, q);
+}
+
+avx2_dispatch! {
+    /// The two products `y1 = a1 · x` and `y2 = a2 · x` (padded, ld × q) in one pass:
+    /// [`mul_vec_padded`] twice, with twice the independent sums in flight.
+    mul_vec2_padded => mul_vec2_padded_kernel(a1: &[f64], a2: &[f64], x: &[f64], y1: &mut [f64], y2: &mut [f64], ld: usize, q: usize)
+}
+
+#[inline(always)]
+fn mul_vec2_padded_kernel(a1: &[f64], a2: &[f64], x: &[f64], y1: &mut [f64], y2: &mut [f64], ld: usize, q: usize) {
+    mul_vec_streams([a1, a2], [x, x], [y1, y2], ld, q);
+}
+
+/// `y_s (ld) = a_s (ld × q) · x_s (q)` for `S` products at once, `PASS` blocks of `BLOCK` rows
+/// per pass over the columns: every row's sum runs over the columns in order from 0 (as in
+/// [`mul_vec`]), but `S · PASS · BLOCK / 4` independent sums share a pass, so the adds' latency
+/// (a dependent chain of q adds per sum) overlaps instead of adding up.
+#[inline(always)]
+fn mul_vec_streams<const S: usize>(a: [&[f64]; S], x: [&[f64]; S], mut y: [&mut [f64]; S], ld: usize, q: usize) {
+    const PASS: usize = 2;
+    let blocks = ld / BLOCK;
+    let mut b = 0;
+    while b + PASS <= blocks {
+        mul_vec_pass::<S, PASS>(&a, &x, &mut y, ld, q, b);
+        b += PASS;
+    }
+    if b < blocks {
+        mul_vec_pass::<S, 1>(&a, &x, &mut y, ld, q, b);
+    }
+}
+
+/// Rows `b0 · BLOCK ..< (b0 + G) · BLOCK` of [`mul_vec_streams`].
+#[inline(always)]
+fn mul_vec_pass<const S: usize, const G: usize>(a: &[&[f64]; S], x: &[&[f64]; S], y: &mut [&mut [f64]; S], ld: usize, q: usize, b0: usize) {
+    let mut acc = [[[0.0; BLOCK]; G]; S];
+    for k in 0..q {
+        for s in 0..S {
+            let xk = x[s][k];
+            let col = &a[s][k * ld + b0 * BLOCK..][..G * BLOCK];
+            for (g, acc) in acc[s].iter_mut().enumerate() {
+                let ab: &[f64; BLOCK] = col[g * BLOCK..(g + 1) * BLOCK].try_into().unwrap();
+                for (t, aik) in acc.iter_mut().zip(ab) {
+                    *t += aik * xk;
+                }
             }
         }
-        yb.copy_from_slice(&acc);
+    }
+    for (ys, accs) in y.iter_mut().zip(&acc) {
+        for (g, acc) in accs.iter().enumerate() {
+            ys[(b0 + g) * BLOCK..(b0 + g + 1) * BLOCK].copy_from_slice(acc);
+        }
     }
 }
 
 avx2_dispatch! {
-    /// `a (ld × q) -= u (ld) · vᵀ (q)`, `a` and `u` padded (the rank-one case of [`sub_mul_nt`]).
+    /// `a (ld × q) -= u (ld) · vᵀ (q)` (the rank-one case of [`sub_mul_nt`]; columns skipped
+    /// where `v` is 0), usually on padded `a` and `u`.
     sub_outer_padded => sub_outer_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], ld: usize, q: usize)
 }
 
 #[inline(always)]
-fn sub_outer_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], ld: usize, q: usize) {
+pub(crate) fn sub_outer_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], ld: usize, q: usize) {
     let u = &u[..ld];
     for (col, &vk) in a[..ld * q].chunks_exact_mut(ld).zip(&v[..q]) {
         if vk != 0.0 {
@@ -148,14 +171,65 @@ fn sub_outer_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], ld: usize, q: us
 }
 
 avx2_dispatch! {
+    /// [`sub_outer_padded`], then `y (ld) = a · x (q)` with the updated `a`, in one pass over
+    /// `a`: the same operations, in the same order, as the two calls one after the other.
+    sub_outer_mul_vec_padded => sub_outer_mul_vec_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], x: &[f64], y: &mut [f64], ld: usize, q: usize)
+}
+
+#[inline(always)]
+fn sub_outer_mul_vec_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], x: &[f64], y: &mut [f64], ld: usize, q: usize) {
+    const PASS: usize = 2;
+    let blocks = ld / BLOCK;
+    let mut b = 0;
+    while b + PASS <= blocks {
+        sub_outer_mul_vec_pass::<PASS>(a, u, v, x, y, ld, q, b);
+        b += PASS;
+    }
+    if b < blocks {
+        sub_outer_mul_vec_pass::<1>(a, u, v, x, y, ld, q, b);
+    }
+}
+
+/// Rows `b0 · BLOCK ..< (b0 + G) · BLOCK` of [`sub_outer_mul_vec_padded`].
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn sub_outer_mul_vec_pass<const G: usize>(a: &mut [f64], u: &[f64], v: &[f64], x: &[f64], y: &mut [f64], ld: usize, q: usize, b0: usize) {
+    let mut acc = [[0.0; BLOCK]; G];
+    let u = &u[b0 * BLOCK..(b0 + G) * BLOCK];
+    for ((col, &vk), &xk) in a[..ld * q].chunks_exact_mut(ld).zip(&v[..q]).zip(&x[..q]) {
+        let col = &mut col[b0 * BLOCK..(b0 + G) * BLOCK];
+        for ((acc, cb), ub) in acc.iter_mut().zip(col.chunks_exact_mut(BLOCK)).zip(u.chunks_exact(BLOCK)) {
+            if vk != 0.0 {
+                for (c, x) in cb.iter_mut().zip(ub) {
+                    *c -= vk * x;
+                }
+            }
+            for (t, c) in acc.iter_mut().zip(cb.iter()) {
+                *t += c * xk;
+            }
+        }
+    }
+    for (g, acc) in acc.iter().enumerate() {
+        y[(b0 + g) * BLOCK..(b0 + g + 1) * BLOCK].copy_from_slice(acc);
+    }
+}
+
+avx2_dispatch! {
     /// `c (ld × p) = a (ld × q) · b (q × p)`, `a` and `c` padded: [`mul_vec_padded`] per column.
     mul_padded => mul_padded_kernel(a: &[f64], b: &[f64], c: &mut [f64], ld: usize, q: usize, p: usize)
 }
 
 #[inline(always)]
 fn mul_padded_kernel(a: &[f64], b: &[f64], c: &mut [f64], ld: usize, q: usize, p: usize) {
-    for (cj, bj) in c[..ld * p].chunks_exact_mut(ld).zip(b[..q * p].chunks_exact(q)) {
-        mul_vec_padded_kernel(a, bj, cj, ld, q);
+    // two columns per pass (independent sums in flight), then the odd one
+    let (c2, c1) = c[..ld * p].split_at_mut(ld * (p / 2 * 2));
+    let (b2, b1) = b[..q * p].split_at(q * (p / 2 * 2));
+    for (cj, bj) in c2.chunks_exact_mut(2 * ld).zip(b2.chunks_exact(2 * q)) {
+        let (c0, c1) = cj.split_at_mut(ld);
+        mul_vec_streams([a, a], [&bj[..q], &bj[q..]], [c0, c1], ld, q);
+    }
+    if !c1.is_empty() {
+        mul_vec_streams([a], [b1], [c1], ld, q);
     }
 }
 

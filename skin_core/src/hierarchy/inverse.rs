@@ -8,6 +8,7 @@
 //!   reduction + implicit QL; nalgebra's `SymmetricEigen` does the same but allocates) and every
 //!   eigenvalue is inverted by the filter [`InverseParams::filter`].
 
+use super::dense::sub_outer_padded_kernel;
 use super::HierarchyError;
 
 /// Parameters of the damped, rank-aware inverse of `A = J̄ M⁻¹ J̄ᵀ` (paper 003 eq. 23, 25).
@@ -91,43 +92,47 @@ pub(crate) struct InverseInfo {
     pub(crate) min_kept: f64,
 }
 
-/// Cholesky `M = L Lᵀ` of the SPD `m` (n × n, column-major, lower triangle read) into `l`
-/// (lower triangle written, upper zeroed). Fails on a pivot that is not clearly positive.
-pub(crate) fn cholesky(m: &[f64], l: &mut [f64], n: usize) -> Result<(), HierarchyError> {
-    l[..n * n].fill(0.0);
-    // left-looking, column by column: L[j.., j] = M[j.., j] − Σ_{k<j} L[j, k] L[j.., k], so every
-    // inner loop runs down a contiguous column
-    for j in 0..n {
-        let (done, rest) = l.split_at_mut(j * n);
-        let col = &mut rest[j..n];
-        col.copy_from_slice(&m[j * n + j..(j + 1) * n]);
-        for k in 0..j {
-            let lk = &done[k * n..(k + 1) * n];
-            let ljk = lk[j];
-            if ljk != 0.0 {
-                for (c, x) in col.iter_mut().zip(&lk[j..n]) {
-                    *c -= ljk * x;
-                }
-            }
-        }
-        let d = col[0];
+avx2_dispatch! {
+    /// Cholesky `M = L Lᵀ` of the SPD `m` (n × n, column-major, lower triangle read) into `l`
+    /// (ld × n, ld ≥ n: lower triangle written, upper and rows n.. zeroed). Fails on a pivot that is
+    /// not clearly positive.
+    ///
+    /// Right-looking: once column k is final, `L[i, c] −= L[c, k] L[i, k]` (i ≥ c) in every later
+    /// column c. Each entry gets `M[i, c] − Σ_{k<c} L[c, k] L[i, k]` subtracted in the order of k, as
+    /// a left-looking column-by-column pass would, but the later columns' updates are independent of
+    /// each other instead of one dependent chain per column.
+    cholesky => cholesky_kernel(m: &[f64], l: &mut [f64], n: usize, ld: usize) -> Result<(), HierarchyError>
+}
+
+#[inline(always)]
+fn cholesky_kernel(m: &[f64], l: &mut [f64], n: usize, ld: usize) -> Result<(), HierarchyError> {
+    super::dense::pad(m, l, n, ld, n);
+    for k in 0..n {
+        let (done, later) = l[..ld * n].split_at_mut((k + 1) * ld);
+        let col = &mut done[k * ld..];
+        let d = col[k];
         // relative guard: a pivot at round-off level means M is singular to working precision
         // (NaN fails `>`, hence the explicit finiteness check)
-        if !d.is_finite() || d <= f64::EPSILON * m[j * n + j].abs() {
-            return Err(HierarchyError::NotPositiveDefinite { index: j, pivot: d });
+        if !d.is_finite() || d <= f64::EPSILON * m[k * n + k].abs() {
+            return Err(HierarchyError::NotPositiveDefinite { index: k, pivot: d });
         }
+        // rows above k: the other columns' updates (never read), now zero
+        col[..k].fill(0.0);
         let inv = 1.0 / d.sqrt();
-        for c in col.iter_mut() {
-            *c *= inv;
+        for x in col.iter_mut() {
+            *x *= inv;
         }
+        // whole columns: rows below c as described, rows up to c (zeroed at their turn) too
+        sub_outer_padded_kernel(later, col, &col[k + 1..n], ld, n - k - 1);
     }
     Ok(())
 }
 
-/// `M⁻¹ = L⁻ᵀ L⁻¹` from the Cholesky factor `l`; `linv` is scratch (n × n), `minv` the result
-/// (full symmetric matrix).
+/// `M⁻¹ = L⁻ᵀ L⁻¹` from the Cholesky factor `l` (n × n); `linv` receives `L⁻¹`, `minv` the
+/// result (full symmetric matrix).
 pub(crate) fn spd_inverse_from_cholesky(l: &[f64], linv: &mut [f64], minv: &mut [f64], n: usize) {
-    lower_inverse(l, linv, n);
+    lower_inverse_rows(l, n, minv, n, n); // minv: scratch for the rows
+    transpose(minv, linv, n);
     // (L⁻ᵀ L⁻¹)_ij = Σ_{k ≥ max(i,j)} L⁻¹_ki L⁻¹_kj: a dot product of two column tails
     for j in 0..n {
         for i in 0..=j {
@@ -138,43 +143,64 @@ pub(crate) fn spd_inverse_from_cholesky(l: &[f64], linv: &mut [f64], minv: &mut 
     }
 }
 
-/// [`spd_inverse_from_cholesky`] into the padded `minv` (ld × n, `dense::padded_len`): the same
-/// sums `Σ_k L⁻¹_ki L⁻¹_kj` in the same order, as rank-one updates with the rows `r_k` of `L⁻¹`
-/// (nonzero up to column k) down padded columns instead of n² short dot products. `linv` (n × n)
-/// and `rows` (ld × n, the rows as padded columns) are scratch.
-pub(crate) fn spd_inverse_padded(l: &[f64], linv: &mut [f64], rows: &mut [f64], minv: &mut [f64], n: usize, ld: usize) {
-    lower_inverse(l, linv, n);
-    for (k, rk) in rows[..ld * n].chunks_exact_mut(ld).enumerate() {
-        for (j, x) in rk.iter_mut().enumerate() {
-            *x = if j < n { linv[j * n + k] } else { 0.0 };
+avx2_dispatch! {
+    /// [`spd_inverse_from_cholesky`] from the padded factor `l` (ld × n) into the padded `minv`
+    /// (ld × n, `dense::padded_len`): the same sums `Σ_k L⁻¹_ki L⁻¹_kj` in the same order, as
+    /// rank-one updates with the rows `r_k` of `L⁻¹` (nonzero up to column k) down padded columns
+    /// instead of n² short dot products. `rows` (ld × n) receives the rows as padded columns,
+    /// `linv` (n × n) `L⁻¹`.
+    spd_inverse_padded => spd_inverse_padded_kernel(l: &[f64], linv: &mut [f64], rows: &mut [f64], minv: &mut [f64], n: usize, ld: usize)
+}
+
+#[inline(always)]
+fn spd_inverse_padded_kernel(l: &[f64], linv: &mut [f64], rows: &mut [f64], minv: &mut [f64], n: usize, ld: usize) {
+    lower_inverse_rows(l, ld, rows, n, ld);
+    for (k, rk) in rows[..ld * n].chunks_exact(ld).enumerate() {
+        for (j, x) in rk[..n].iter().enumerate() {
+            linv[j * n + k] = *x;
         }
     }
     // −M⁻¹ = −Σ_k r_k r_kᵀ (the columns j ≤ k that r_k reaches), then negated: exact
     minv[..ld * n].fill(0.0);
     for (k, rk) in rows[..ld * n].chunks_exact(ld).enumerate() {
-        super::dense::sub_outer_padded(&mut minv[..ld * (k + 1)], rk, &rk[..=k], ld, k + 1);
+        sub_outer_padded_kernel(&mut minv[..ld * (k + 1)], rk, &rk[..=k], ld, k + 1);
     }
     for x in &mut minv[..ld * n] {
         *x = -*x;
     }
 }
 
-/// `L⁻¹` of the lower triangular `l` into `linv` (n × n): column j by forward substitution
-/// `L x = e_j`, column-oriented.
-fn lower_inverse(l: &[f64], linv: &mut [f64], n: usize) {
-    linv[..n * n].fill(0.0);
-    for j in 0..n {
-        let x = &mut linv[j * n..(j + 1) * n];
-        x[j] = 1.0;
-        for k in j..n {
-            let lk = &l[k * n..(k + 1) * n];
-            let xk = x[k] / lk[k];
-            x[k] = xk;
-            if xk != 0.0 {
-                for (xi, li) in x[k + 1..].iter_mut().zip(&lk[k + 1..]) {
-                    *xi -= xk * li;
-                }
-            }
+/// The rows of `L⁻¹` (lower triangular `l`, n × n with leading dimension `ldl`) as the columns
+/// of `rows` (ld × n, zero below row k in column k and below row n): forward substitution
+/// `L x = e_j` for all j at once, row k of `L⁻¹` final at step k:
+///
+/// ```text
+/// r_k ← r_k / L[k, k],   r_i ← r_i − L[i, k] r_k  (i > k)
+/// ```
+///
+/// Every entry sees the same operations, in the same order, as a substitution column by column
+/// (plus subtractions of `L[i, k] · 0` that change nothing), but the k-th step's updates are
+/// independent of each other (no chain of divisions per column), and run down whole columns.
+#[inline(always)]
+fn lower_inverse_rows(l: &[f64], ldl: usize, rows: &mut [f64], n: usize, ld: usize) {
+    super::dense::set_identity_padded(rows, n, ld);
+    for k in 0..n {
+        let lk = &l[k * ldl..k * ldl + n];
+        let (done, later) = rows[..ld * n].split_at_mut((k + 1) * ld);
+        // whole columns: the entries past k are 0 in r_k and stay as they are in r_i
+        let rk = &mut done[k * ld..];
+        for x in rk.iter_mut() {
+            *x /= lk[k];
+        }
+        sub_outer_padded_kernel(later, rk, &lk[k + 1..], ld, n - k - 1);
+    }
+}
+
+/// `dst = srcᵀ` (n × n).
+fn transpose(src: &[f64], dst: &mut [f64], n: usize) {
+    for (j, col) in src[..n * n].chunks_exact(n).enumerate() {
+        for (i, x) in col.iter().enumerate() {
+            dst[i * n + j] = *x;
         }
     }
 }
@@ -398,7 +424,7 @@ pub(crate) fn damped_inverse(
     params: &InverseParams,
 ) -> InverseInfo {
     let trace: f64 = (0..m).map(|i| a[i * m + i]).sum();
-    if trace > 0.0 && cholesky(a, v, m).is_ok() {
+    if trace > 0.0 && cholesky(a, v, m, m).is_ok() {
         spd_inverse_from_cholesky(v, w, out, m);
         let e_min_bound = 1.0 / super::dense::norm(&out[..m * m]);
         // e_max ≤ trace bounds the relative threshold from above
@@ -452,7 +478,7 @@ mod tests {
         for n in [1, 2, 7, 15, 20] {
             let m = random_spd(n, n as u64);
             let (mut l, mut li, mut mi) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
-            cholesky(m.as_slice(), &mut l, n).unwrap();
+            cholesky(m.as_slice(), &mut l, n, n).unwrap();
             spd_inverse_from_cholesky(&l, &mut li, &mut mi, n);
             let mi = DMatrix::from_column_slice(n, n, &mi);
             let err = (&m * &mi - DMatrix::identity(n, n)).norm();
@@ -467,9 +493,14 @@ mod tests {
             let ld = crate::hierarchy::dense::padded_len(n);
             let (mut l, mut li, mut mi) = (vec![0.0; n * n], vec![0.0; n * n], vec![0.0; n * n]);
             let (mut rows, mut mp, mut back) = (vec![0.0; ld * n], vec![1.0; ld * n], vec![0.0; n * n]);
-            cholesky(m.as_slice(), &mut l, n).unwrap();
+            let (mut lp, mut lip) = (vec![1.0; ld * n], vec![0.0; n * n]);
+            cholesky(m.as_slice(), &mut l, n, n).unwrap();
             spd_inverse_from_cholesky(&l, &mut li, &mut mi, n);
-            spd_inverse_padded(&l, &mut li, &mut rows, &mut mp, n, ld);
+            cholesky(m.as_slice(), &mut lp, n, ld).unwrap();
+            crate::hierarchy::dense::unpad(&lp, &mut back, n, ld, n);
+            assert_eq!(back, l, "n = {n}: padded factor");
+            spd_inverse_padded(&lp, &mut lip, &mut rows, &mut mp, n, ld);
+            assert_eq!(lip, li, "n = {n}: L⁻¹");
             crate::hierarchy::dense::unpad(&mp, &mut back, n, ld, n);
             assert_eq!(back, mi, "n = {n}");
             assert!(mp.chunks_exact(ld).all(|c| c[n..].iter().all(|&x| x == 0.0)), "padding stays zero");
@@ -480,7 +511,7 @@ mod tests {
     fn cholesky_rejects_indefinite() {
         let m = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
         let mut l = vec![0.0; 4];
-        assert!(matches!(cholesky(m.as_slice(), &mut l, 2), Err(HierarchyError::NotPositiveDefinite { index: 1, .. })));
+        assert!(matches!(cholesky(m.as_slice(), &mut l, 2, 2), Err(HierarchyError::NotPositiveDefinite { index: 1, .. })));
     }
 
     #[test]

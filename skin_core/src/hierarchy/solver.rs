@@ -6,7 +6,7 @@ use nalgebra::{DMatrix, DVector};
 use crate::model::{bias_forces, crba, ModelData, RobotModel};
 
 use super::dense::{
-    add_mul_vec, axpy, dot, mul, mul_padded, mul_tn, mul_tr_vec, mul_vec, mul_vec_padded, norm, pad, padded_len, set_identity_padded,
+    add_mul_vec, axpy, dot, mul, mul_padded, mul_tn, mul_tr_vec, mul_vec, mul_vec2_padded, mul_vec_padded, sub_outer_mul_vec_padded, norm, pad, padded_len, set_identity_padded,
     sub_mul_nt, sub_outer_padded, unpad,
 };
 use super::inverse::{cholesky, damped_inverse, spd_inverse_padded, symmetric_eigen, InverseParams};
@@ -61,7 +61,9 @@ pub struct HierarchySolver {
     max_levels: usize,
     max_rows: usize,
     params: InverseParams,
+    /// `L` of `M = L Lᵀ` (also padded: `chol_pad`) and `L⁻¹`, n × n.
     chol: Vec<f64>,
+    chol_pad: Vec<f64>,
     linv: Vec<f64>,
     minv: DMatrix<f64>,
     /// N_L of the last solve (copied from `nproj_pad`).
@@ -111,6 +113,7 @@ impl HierarchySolver {
             max_rows,
             params,
             chol: vec![0.0; n * n],
+            chol_pad: vec![0.0; ld * n],
             linv: vec![0.0; n * n],
             minv: DMatrix::zeros(n, n),
             nproj: DMatrix::identity(n, n),
@@ -206,8 +209,9 @@ impl HierarchySolver {
         self.check_inputs(mass_matrix, posture, bias, tau_out)?;
         let levels = levels.into_iter();
 
-        cholesky(mass_matrix.as_slice(), &mut self.chol, n)?;
-        spd_inverse_padded(&self.chol, &mut self.linv, &mut self.z, &mut self.minv_pad, n, ld);
+        cholesky(mass_matrix.as_slice(), &mut self.chol_pad, n, ld)?;
+        unpad(&self.chol_pad, &mut self.chol, n, ld, n);
+        spd_inverse_padded(&self.chol_pad, &mut self.linv, &mut self.z, &mut self.minv_pad, n, ld);
         unpad(&self.minv_pad, self.minv.as_mut_slice(), n, ld, n);
         set_identity_padded(&mut self.nproj_pad, n, ld);
         self.tau_sum.fill(0.0);
@@ -448,40 +452,45 @@ impl HierarchySolver {
     }
 
     /// The row-by-row projector update of [`Self::activated_level`] on the padded `N` and `M⁻¹`:
-    /// `4 n²` per row, the level's main cost (the torque costs `n m`).
+    /// `4 n²` per row, the level's main cost (the torque costs `n m`). The next row's `N j_iᵀ`
+    /// is summed in the pass that updates `N` (the same sums as after it).
     fn project_activated_rows(&mut self, level: &TaskLevel, diag: &mut LevelDiagnostics, first: &mut bool) {
         let (n, ld) = (self.nv, padded_len(self.nv));
         let [jb, mj, nj] = &mut self.row_pad;
+        let row = |i: usize| level.jt_slice().get(i * n..(i + 1) * n);
         jb.fill(0.0);
-        for (row, &a) in level.jt_slice().chunks_exact(n).zip(level.activation()) {
-            // j̄ᵀ = N j_iᵀ (jb), M⁻¹ j̄ᵀ (mj), N j̄ᵀ (nj)
+        // j̄ᵀ = N j_iᵀ (jb), M⁻¹ j̄ᵀ (mj), N j̄ᵀ (nj)
+        if let Some(r) = row(0) {
+            project_row(&self.nproj_pad, r, jb, *first, ld);
+        }
+        for (i, &a) in level.activation().iter().enumerate() {
             if *first {
-                jb[..n].copy_from_slice(row);
-            } else {
-                mul_vec_padded(&self.nproj_pad, row, jb, ld, n);
-            }
-            mul_vec_padded(&self.minv_pad, jb, mj, ld, n);
-            let e = dot(&jb[..n], &mj[..n]);
-            let f = self.params.filter(e, self.params.threshold(e));
-            if f <= 0.0 {
-                continue;
-            }
-            diag.min_eigenvalue = if diag.rank == 0 { e } else { diag.min_eigenvalue.min(e) };
-            diag.rank += 1;
-            diag.damped += usize::from(e < self.params.damping);
-            if a <= 0.0 {
-                continue;
-            }
-            if *first {
+                mul_vec_padded(&self.minv_pad, jb, mj, ld, n);
                 nj.copy_from_slice(jb);
             } else {
-                mul_vec_padded(&self.nproj_pad, jb, nj, ld, n);
+                mul_vec2_padded(&self.minv_pad, &self.nproj_pad, jb, mj, nj, ld, n);
             }
-            for x in mj[..n].iter_mut() {
-                *x *= a * f;
+            let e = dot(&jb[..n], &mj[..n]);
+            let f = self.params.filter(e, self.params.threshold(e));
+            if f > 0.0 {
+                diag.min_eigenvalue = if diag.rank == 0 { e } else { diag.min_eigenvalue.min(e) };
+                diag.rank += 1;
+                diag.damped += usize::from(e < self.params.damping);
             }
-            sub_outer_padded(&mut self.nproj_pad, nj, mj, ld, n);
-            *first = false;
+            let next = row(i + 1);
+            if f > 0.0 && a > 0.0 {
+                for x in mj[..n].iter_mut() {
+                    *x *= a * f;
+                }
+                // N ← N − (N j̄ᵀ)(a f M⁻¹ j̄ᵀ)ᵀ, and the next row's N j_{i+1}ᵀ in the same pass
+                match next {
+                    Some(r) => sub_outer_mul_vec_padded(&mut self.nproj_pad, nj, mj, r, jb, ld, n),
+                    None => sub_outer_padded(&mut self.nproj_pad, nj, mj, ld, n),
+                }
+                *first = false;
+            } else if let Some(r) = next {
+                project_row(&self.nproj_pad, r, jb, *first, ld);
+            }
         }
     }
 
@@ -599,6 +608,15 @@ impl HierarchySolver {
             }
         }
         Ok(())
+    }
+}
+
+/// `jb = N rowᵀ` (padded; `N = I` while `identity`).
+fn project_row(nproj_pad: &[f64], row: &[f64], jb: &mut [f64], identity: bool, ld: usize) {
+    if identity {
+        jb[..row.len()].copy_from_slice(row);
+    } else {
+        mul_vec_padded(nproj_pad, row, jb, ld, row.len());
     }
 }
 

@@ -52,6 +52,8 @@ pub struct BaseAvoidance {
     best: Vec<(f64, Vector2<f64>, Vector2<f64>)>,
     /// Pseudo-angles of the inner sector bounds `2π k/n`, k = 1..n.
     bounds: Vec<f64>,
+    /// Unit directions of the sector bounds `2π k/n`, k = 0..=n.
+    edges: Vec<Vector2<f64>>,
     tau: DVector<f64>,
 }
 
@@ -72,7 +74,13 @@ impl BaseAvoidance {
                 diamond_angle(s, c)
             })
             .collect();
-        Ok(Self { params, joints, best: vec![(f64::INFINITY, Vector2::zeros(), Vector2::zeros()); n], bounds, tau: DVector::zeros(nv) })
+        let edges = (0..=n)
+            .map(|k| {
+                let (s, c) = (std::f64::consts::TAU * k as f64 / n as f64).sin_cos();
+                Vector2::new(c, s)
+            })
+            .collect();
+        Ok(Self { params, joints, best: vec![(f64::INFINITY, Vector2::zeros(), Vector2::zeros()); n], bounds, edges, tau: DVector::zeros(nv) })
     }
 
     /// The sector of `p`: sector `s` spans the angles `atan2(y, x) + π ∈ [2π s/n, 2π (s+1)/n)`.
@@ -83,6 +91,19 @@ impl BaseAvoidance {
     fn sector(&self, p: &Vector2<f64>) -> usize {
         let a = diamond_angle(-p.y, -p.x);
         self.bounds.iter().map(|&b| usize::from(a >= b)).sum()
+    }
+
+    /// [`Self::sector`] when `p` is likely in sector `hint` (a scan runs around in angle, so
+    /// most points fall in the sector of the one before): two cross products with the hinted
+    /// sector's bound directions instead of a division, accepted only with a margin (far above
+    /// the rounding of either test), so the result is [`Self::sector`]'s in every case.
+    fn sector_near(&self, p: &Vector2<f64>, hint: usize) -> usize {
+        let d = -p;
+        let margin = 1e-9 * (d.x.abs() + d.y.abs());
+        if self.edges[hint].perp(&d) > margin && d.perp(&self.edges[hint + 1]) > margin {
+            return hint;
+        }
+        self.sector(p)
     }
 
     /// Closest footprint point to `p` (base frame) and its distance (0 inside).
@@ -106,6 +127,7 @@ impl BaseAvoidance {
         let range_sq = self.params.range_m * self.params.range_m;
         // squared distances in the scan loop (a scan has hundreds of points); the square root
         // and the sector's angle only for points in range
+        let mut last = 0;
         for p in points {
             if !(p.x.is_finite() && p.y.is_finite()) {
                 continue;
@@ -115,7 +137,8 @@ impl BaseAvoidance {
             if d_sq <= 0.0 || d_sq > range_sq {
                 continue;
             }
-            let s = self.sector(p);
+            let s = self.sector_near(p, last);
+            last = s;
             if d_sq < self.best[s].0 {
                 self.best[s] = (d_sq, *p, c);
             }
@@ -152,25 +175,52 @@ mod tests {
     use super::*;
     use crate::tasks::params::BaseAvoidanceParams;
 
-    /// The pseudo-angle binning equals the `atan2` definition of the sectors.
+    fn with_sectors(n: usize) -> BaseAvoidance {
+        let params = BaseAvoidanceParams {
+            f_max_n: 1.0,
+            alpha_m: 0.1,
+            range_m: 1.0,
+            footprint_x_m: [-0.1, 0.1],
+            footprint_y_m: [-0.1, 0.1],
+            sectors: n,
+        };
+        BaseAvoidance::new(3, [0, 1, 2], params).unwrap()
+    }
+
+    /// The pseudo-angle binning equals the `atan2` definition of the sectors, with or without a
+    /// hint.
     #[test]
     fn sectors_match_atan2() {
-        for n in [1, 3, 8, 13] {
-            let params = BaseAvoidanceParams {
-                f_max_n: 1.0,
-                alpha_m: 0.1,
-                range_m: 1.0,
-                footprint_x_m: [-0.1, 0.1],
-                footprint_y_m: [-0.1, 0.1],
-                sectors: n,
-            };
-            let b = BaseAvoidance::new(3, [0, 1, 2], params).unwrap();
+        for n in [1, 2, 3, 8, 13] {
+            let b = with_sectors(n);
             for k in 0..3600 {
                 let a = (k as f64 + 0.37) * std::f64::consts::TAU / 3600.0;
                 let p = Vector2::new(a.cos(), a.sin()) * (0.5 + (k % 7) as f64);
                 let angle = p.y.atan2(p.x) + std::f64::consts::PI;
                 let want = ((angle / std::f64::consts::TAU * n as f64) as usize).min(n - 1);
                 assert_eq!(b.sector(&p), want, "n = {n}, angle {a}");
+                for hint in 0..n {
+                    assert_eq!(b.sector_near(&p, hint), want, "n = {n}, angle {a}, hint {hint}");
+                }
+            }
+        }
+    }
+
+    /// On and next to the sector bounds (where the tests' rounding could disagree) the hint
+    /// never changes the sector.
+    #[test]
+    fn hint_agrees_on_bounds() {
+        for n in [2, 4, 8, 13, 360] {
+            let b = with_sectors(n);
+            for k in 0..n {
+                for da in [-1e-15, -1e-12, 0.0, 1e-12, 1e-15] {
+                    let (s, c) = (std::f64::consts::TAU * k as f64 / n as f64 + da).sin_cos();
+                    for p in [-Vector2::new(c, s), -Vector2::new(c, s) * 3.7] {
+                        for hint in [0, k.saturating_sub(1), k, (k + 1) % n] {
+                            assert_eq!(b.sector_near(&p, hint), b.sector(&p), "n = {n}, bound {k} {da}, hint {hint}");
+                        }
+                    }
+                }
             }
         }
     }

@@ -381,11 +381,11 @@ fn tasks_do_not_allocate_after_setup() {
 
 /// The whole cycle (`Controller::update`) on TOMM with skin activity, a goal and a laser scan,
 /// across arrangement switches of both policies (paper 003 phases on request; paper 000 (a) -> (c)
-/// on a contact force), and through a safe-stop step.
+/// on a contact force), through a safe-stop step and with a commanded base motion.
 #[test]
 fn controller_cycle_does_not_allocate_after_setup() {
     use nalgebra::{Isometry3, Vector2};
-    use skin_core::controller::{Controller, ControllerConfig, ControllerInput};
+    use skin_core::controller::{BaseReference, Controller, ControllerConfig, ControllerInput};
 
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
     for policy in [Policy::Phases, Policy::IntentionalContact] {
@@ -423,6 +423,13 @@ fn controller_cycle_does_not_allocate_after_setup() {
                 for i in (0..n).step_by(5) {
                     cells[i] = CellReading::uniform(1.0, 1.0);
                 }
+            }
+            if (40..50).contains(&k) {
+                // a commanded base motion (paper 003 Exp. 1), then back to q_post
+                let r = BaseReference { position: [0.01 * k as f64, 0.0, 0.0], velocity: [0.05, 0.0, 0.0] };
+                c.set_base_reference(Some(r)).unwrap();
+            } else if k == 50 {
+                c.set_base_reference(None).unwrap();
             }
             let dt = if k == 30 { f64::NAN } else { 0.008 };
             std::hint::black_box(step(&mut c, &cells, dt));

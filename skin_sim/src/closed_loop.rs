@@ -1,7 +1,7 @@
 //! The in-process closed loop: a MuJoCo [`World`] and a skin_core [`Controller`] in lockstep at
 //! the scene's control rate. Per control period: read the world (q, q̇ in model order, skin
 //! cells, LIDAR points in the base frame), give the controller the scene's goal, force
-//! reference and phase for this time ([`Schedule`]), run `Controller::update`, send its arm
+//! reference, base motion and phase for this time ([`Schedule`]), run `Controller::update`, send its arm
 //! joint velocities and base twist, and step the world through the period. Nothing depends on
 //! wall-clock time, so a run is a function of the scene (and its seed).
 //!
@@ -157,7 +157,7 @@ impl ClosedLoop {
         if let Some(lidar) = self.world.lidar() {
             self.scan.extend(lidar.points().iter().map(|&[x, y]| Vector2::new(x, y)));
         }
-        let scheduled = self.schedule.apply(t_s, &mut self.controller);
+        let scheduled = self.schedule.apply(t_s, self.world.q(), &mut self.controller);
         let input = ControllerInput {
             t_s,
             dt_s: self.dt_s,

@@ -1,6 +1,7 @@
 //! When the scene's user interacts with the robot: a scripted push on a robot link (touches of
 //! paper 003 Exp. 2-4, green areas) or a person within the base avoidance range of the base
-//! footprint (red areas). Paper 003 Table 3 splits the force-tracking error by these periods.
+//! footprint (red areas), or a commanded base motion (paper 003 Exp. 1's circle and swings).
+//! Paper 003 Table 3 splits the force-tracking error by these periods.
 
 use skin_core::resolver::BASE_JOINTS;
 use skin_core::tasks::params::BaseAvoidanceParams;
@@ -10,8 +11,8 @@ use crate::scene::{PersonSpec, PushSpec, Scene};
 /// The scripted interactions of a scene.
 #[derive(Debug, Clone)]
 pub struct Interactions {
-    /// Windows `[start, end)` of pushes on robot links.
-    touches: Vec<(f64, f64)>,
+    /// Windows `[start, end)` of pushes on robot links and of base motions.
+    windows: Vec<(f64, f64)>,
     persons: Vec<PersonSpec>,
     /// Model indices of base x, y, yaw (None: no base, persons never count).
     base: Option<[usize; 3]>,
@@ -24,7 +25,9 @@ impl Interactions {
         let on_robot = |p: &&PushSpec| p.link.is_some();
         let base = BASE_JOINTS.map(|n| scene.model.joint_index(n));
         Interactions {
-            touches: scene.spec.pushes.iter().filter(on_robot).map(|p| (p.start_s, p.end_s)).collect(),
+            windows: (scene.spec.pushes.iter().filter(on_robot).map(|p| (p.start_s, p.end_s)))
+                .chain(scene.spec.base_motions.iter().map(|m| (m.start_s, m.end_s)))
+                .collect(),
             persons: scene.spec.persons.clone(),
             base: match base {
                 [Some(x), Some(y), Some(w)] => Some([x, y, w]),
@@ -36,7 +39,7 @@ impl Interactions {
 
     /// Whether an interaction is going on at `t_s` with the robot at `q` (model order).
     pub fn active(&self, t_s: f64, q: &[f64]) -> bool {
-        self.touches.iter().any(|&(a, b)| t_s >= a && t_s < b) || self.person_near(t_s, q)
+        self.windows.iter().any(|&(a, b)| t_s >= a && t_s < b) || self.person_near(t_s, q)
     }
 
     /// A person's surface within `range_m` of the footprint rectangle (base frame).

@@ -18,6 +18,7 @@
 #![warn(missing_docs)]
 
 pub mod bag;
+pub mod base_motion;
 mod cell_face;
 pub mod closed_loop;
 mod frames;

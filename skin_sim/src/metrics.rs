@@ -12,7 +12,9 @@ use crate::scene::Scene;
 /// An interaction's effect on the force outlasts it: cycles this long after one count as "with
 /// interaction" too \[s\].
 pub const INTERACTION_TAIL_S: f64 = 2.0;
-/// The force-tracking error is taken once the contact phase has settled this long \[s\].
+/// The force-tracking error is taken once the hand has been in contact this long in the contact
+/// phase \[s\] (from its first touch, not from the phase switch: the approach in between is no
+/// tracking).
 pub const CONTACT_SETTLE_S: f64 = 3.0;
 /// The hard-contact reaction must relieve a push within this time after it ends \[s\] (the
 /// issue's outcome).
@@ -197,7 +199,8 @@ fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: Limits) -> GoalMe
 }
 
 fn force_metrics(cycles: &[CycleRecord]) -> ForceMetrics {
-    let contact_from = cycles.iter().find(|c| c.mode == Mode::Contact).map_or(f64::INFINITY, |c| c.t_s);
+    let touched = |c: &&CycleRecord| c.mode == Mode::Contact && c.hand_force_n > 0.0;
+    let contact_from = cycles.iter().find(touched).map_or(f64::INFINITY, |c| c.t_s);
     // Interaction windows, extended by their tail.
     let mut last_interaction = f64::NEG_INFINITY;
     let mut settled = Vec::new(); // (cycle, with interaction)

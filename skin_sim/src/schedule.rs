@@ -1,6 +1,6 @@
 //! What the scene tells the controller over time: the active end-effector goal (`goals`), the
 //! force reference (`force_references`, newtons turned into the hand signal by
-//! [`HandForceMap`]) and, for paper 003's phase policy, the switch to the contact phase when
+//! [`HandForceMap`]), the commanded base motion (`base_motions`, [`BaseMotions`]) and, for paper 003's phase policy, the switch to the contact phase when
 //! the first force reference starts (paper 003 Sec. 4.2.2: "the contact phase is manually
 //! activated by the user"; the scene's `start_s` is that moment).
 
@@ -8,6 +8,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use skin_core::controller::{Controller, Fault};
 use skin_core::supervisor::{Phase, Policy};
 
+use crate::base_motion::BaseMotions;
 use crate::hand_force::HandForceMap;
 use crate::scene::{ForceReferenceSpec, GoalSpec, Scene};
 
@@ -44,6 +45,9 @@ pub struct Schedule {
     goals: Vec<GoalSpec>,
     forces: Vec<ForceReferenceSpec>,
     map: Option<HandForceMap>,
+    motions: BaseMotions,
+    /// Model indices of the base joints (x, y, yaw) when the scene's base moves.
+    base: Option<[usize; 3]>,
     /// Start of the contact phase (paper 003 policy with force references).
     contact_from_s: Option<f64>,
     /// Index of the goal last given to the controller.
@@ -93,6 +97,8 @@ impl Schedule {
             goals,
             forces,
             map,
+            motions: BaseMotions::new(&spec.base_motions),
+            base: scene.moving_base(),
             contact_from_s,
             active_goal: None,
             contact_requested: false,
@@ -104,9 +110,10 @@ impl Schedule {
         self.map.as_ref()
     }
 
-    /// Gives `controller` what the scene asks for at `t_s`: the goal that started last, the
-    /// force reference as a hand signal, the contact phase once it is due.
-    pub fn apply(&mut self, t_s: f64, controller: &mut Controller) -> Result<ScheduledInputs, Fault> {
+    /// Gives `controller` what the scene asks for at `t_s` with the robot measured at `q` (model
+    /// order): the goal that started last, the force reference as a hand signal, the base
+    /// motion's reference, the contact phase once it is due.
+    pub fn apply(&mut self, t_s: f64, q: &[f64], controller: &mut Controller) -> Result<ScheduledInputs, Fault> {
         let goal = latest(&self.goals, |g| g.start_s, t_s);
         if goal != self.active_goal {
             controller.set_goal(goal.map(|k| goal_pose(&self.goals[k])))?;
@@ -117,6 +124,12 @@ impl Schedule {
             inputs.force_n = self.forces[k].value(t_s);
             inputs.force_signal = map.signal(inputs.force_n);
             controller.set_hand_force_reference(inputs.force_signal)?;
+        }
+        if let Some(b) = self.base {
+            let reference = self.motions.reference(t_s, b.map(|j| q[j]));
+            if reference.is_some() || controller.base_reference().is_some() {
+                controller.set_base_reference(reference)?;
+            }
         }
         if !self.contact_requested && self.contact_from_s.is_some_and(|s| t_s >= s) {
             // The policy is `phases` (checked in new), so the request is accepted.

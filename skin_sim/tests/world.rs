@@ -130,6 +130,17 @@ fn scene_errors_name_the_file_and_the_key() {
     assert!(e.contains("`control_rate_hz`") && e.contains("whole number"), "{e}");
     let e = invalid(&planar7("pushes: [{link: link3, object: b, force_n: [1, 0, 0], start_s: 0, end_s: 1}]\n"));
     assert!(e.contains("`pushes[0]`"), "{e}");
+    let circle = "{start_s: 1, end_s: 19, circle: {radius_m: 0.2, period_s: 5}}";
+    let e = invalid(&planar7(&format!("base_motions: [{circle}]\n")));
+    assert!(e.contains("`base_motions`") && e.contains("does not move"), "{e}");
+    let e = invalid(&planar7("base_motions: [{start_s: 1, end_s: 19, circle: {radius_m: 0.2, period_s: 5}, swing: {amplitude_m: 0.3, period_s: 9, axis: [0, 1]}}]\n"));
+    assert!(e.contains("`base_motions[0]`") && e.contains("exactly one"), "{e}");
+    let e = invalid(&planar7("base_motions: [{start_s: 1, end_s: 9, ramp_s: 5, circle: {radius_m: 0.2, period_s: 5}}]\n"));
+    assert!(e.contains("`base_motions[0].ramp_s`"), "{e}");
+    let e = invalid(&planar7(&format!("base_motions: [{circle}, {{start_s: 20, end_s: 40, swing: {{amplitude_m: 0.3, period_s: 9, axis: [0, 0]}}}}]\n")));
+    assert!(e.contains("`base_motions[1].swing.axis`"), "{e}");
+    let e = invalid(&planar7(&format!("base_motions: [{circle}, {{start_s: 15, end_s: 40, swing: {{amplitude_m: 0.3, period_s: 9, axis: [0, 1]}}}}]\n")));
+    assert!(e.contains("`base_motions[1].start_s`"), "{e}");
     let e = invalid("robot: {urdf: ../../urdf/nope.urdf}\nduration_s: 1\n");
     assert!(e.contains("`robot.urdf`"), "{e}");
     assert!(matches!(

@@ -1,7 +1,8 @@
 //! `mujoco_sim`: a scene's MuJoCo world on the graph. Publishes `/clock`, `/joint_states`,
 //! `/base/odom`, `/scan`, `/skin/cells` (every one stamped with the simulation time of the
 //! period) and the scene's goals (`/goal`, latched) and force references
-//! (`/hand_force_reference`, latched); applies the arm commands and the base twist.
+//! (`/hand_force_reference`, latched); applies the arm commands and the base twist. The scene's
+//! `base_motions` are not on the graph yet (a warning says so at start).
 //!
 //! - **lockstep**: publishes the state of period k, waits for one new message on every command
 //!   topic, applies them, steps one control period. The run is a function of the scene, like the
@@ -390,6 +391,15 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
     let logger = node.logger().to_string();
     let file = scene_file(&options.scene)?;
     let scene = skin_sim::scene::Scene::load(&file).with_context(|| format!("--scene {}", options.scene))?;
+    if !scene.spec.base_motions.is_empty() {
+        // Not yet a topic: the controller's base reference comes from skin_sim's schedule only.
+        r2r::log_warn!(
+            &logger,
+            "{}: its {} base motion(s) (`base_motions`, paper 003 Exp. 1) are not carried by the graph: the controller holds the base at q_post, and a recorded run's \"with\" RMS covers these windows without the motion (run them with `skin_sim run`)",
+            file.display(),
+            scene.spec.base_motions.len()
+        );
+    }
     if options.arm_namespaces.is_empty() && options.arm_prefixes.is_empty() {
         let d = ArmsParams::for_joints(scene.model.joint_names());
         options.arm_namespaces = d.namespaces;

@@ -13,6 +13,7 @@ use crate::skin::live::LiveCells;
 use crate::skin::transforms::{patch_poses_world, patch_wrench_world, sum_patch_forces_in_frame};
 use crate::supervisor::blend::chi;
 use crate::supervisor::{Arrangement, Imposed, Phase, PhaseRefused, Supervisor, SupervisorInput, TorqueBlender};
+use crate::tasks::posture::BaseReference;
 use crate::tasks::rows_times_qd;
 
 /// Maps a stage's error to [`Fault::Stage`] (the error's text would allocate).
@@ -183,6 +184,29 @@ impl Controller {
         let hand_cells: usize = layout.patches().iter().zip(&self.hand_patches).filter(|(_, &h)| h).map(|(p, _)| p.cells.len()).sum();
         self.tasks.set_hand_force_reference(signal.clamp(0.0, hand_cells as f64));
         Ok(())
+    }
+
+    /// Sets the commanded base motion (paper 003 Exp. 1: a circle, lateral swings): the moving
+    /// target `q_d(t)`, `q̇_d(t)` of the base joints in the posture torque of eq. (18), the lowest
+    /// level, so the higher levels keep the hand while the base follows; `None`: back to
+    /// `q_post`. Call it every cycle with the reference for that cycle's time. Refused: a
+    /// non-finite value (`NonFinite`, index 0-2 position, 3-5 velocity), a model without base.
+    pub fn set_base_reference(&mut self, reference: Option<BaseReference>) -> Result<(), Fault> {
+        let Some(joints) = self.resolver.base_joints() else {
+            return match reference {
+                Some(_) => Err(Fault::Stage("base reference (the model has no base joints)")),
+                None => Ok(()),
+            };
+        };
+        self.tasks.posture.set_base_reference(joints, reference).map_err(|e| match e {
+            crate::tasks::TaskError::NonFinite { index, .. } => Fault::NonFinite { input: "base reference", index },
+            _ => Fault::Stage("base reference"),
+        })
+    }
+
+    /// The commanded base motion in use ([`Controller::set_base_reference`]).
+    pub fn base_reference(&self) -> Option<BaseReference> {
+        self.tasks.posture.base_reference()
     }
 
     /// Requests a paper 003 phase (effective at the next update).

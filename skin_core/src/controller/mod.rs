@@ -16,3 +16,4 @@ pub use cycle::Controller;
 pub use io::{ControllerInput, ControllerOutput, Fault};
 pub use setup::{ControllerConfig, ControllerSetup, HierarchyDynamics, SetupError};
 pub use task_set::TaskKind;
+pub use crate::tasks::posture::BaseReference;

@@ -178,3 +178,19 @@ fn locked_base_stays_still_while_the_arm_reaches() {
     let e = c.output().signals.goal_error_m;
     assert!(e < 0.005, "the arm alone reaches the goal in 8 s: error {e} m");
 }
+
+#[test]
+fn a_base_reference_is_validated_and_cleared() {
+    let mut c = controller("tomm");
+    let ok = BaseReference { position: [0.1, -0.2, 0.3], velocity: [0.05, 0.0, 0.0] };
+    c.set_base_reference(Some(ok)).unwrap();
+    assert_eq!(c.base_reference(), Some(ok));
+    let bad = BaseReference { velocity: [0.0, f64::NAN, 0.0], ..ok };
+    assert_eq!(c.set_base_reference(Some(bad)), Err(Fault::NonFinite { input: "base reference", index: 4 }));
+    assert_eq!(c.base_reference(), Some(ok), "a refused reference leaves the last one");
+    c.set_base_reference(None).unwrap();
+    assert_eq!(c.base_reference(), None);
+    let mut arm = controller("planar7");
+    assert!(arm.set_base_reference(Some(ok)).is_err(), "no base joints");
+    arm.set_base_reference(None).unwrap();
+}

@@ -62,6 +62,14 @@ pub enum TaskError {
         /// Given length.
         got: usize,
     },
+    /// A per-cycle input is NaN or infinite.
+    #[error("{what}[{index}] is not finite")]
+    NonFinite {
+        /// What was wrong.
+        what: &'static str,
+        /// Index of the first bad value.
+        index: usize,
+    },
 }
 
 /// `J[row0..row0+3] q̇` of a 6 × nv Jacobian (linear rows: 0, angular rows: 3), no allocation.

@@ -105,6 +105,21 @@ pub struct PostureParams {
     pub d_c: Vec<f64>,
     /// Gain on the body skin torque `τ_skin` (eq. 14) inside `τ_s` \[N per signal unit\].
     pub skin_gain: f64,
+    /// `K_c`, `D_c` of the base joints while they track a commanded base motion
+    /// ([`super::posture::BaseReference`]); none: the base joints' `k_c`, `d_c`.
+    #[serde(default)]
+    pub base_tracking: Option<BaseTrackingGains>,
+}
+
+/// Gains of the base joints (world x, y, yaw) toward a commanded base motion: stiffer than the
+/// posture's, so that the lowest level follows the motion against the arm's own posture pull.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BaseTrackingGains {
+    /// Stiffness along x, y \[N/m\] and about yaw \[N m/rad\].
+    pub k_c: [f64; 3],
+    /// Damping along x, y \[N s/m\] and about yaw \[N m s/rad\].
+    pub d_c: [f64; 3],
 }
 
 /// Every task's parameters (`config/tasks.yaml`).
@@ -198,6 +213,13 @@ impl TaskParams {
             }
             for (i, x) in v.iter().enumerate() {
                 nonneg("posture.", &format!("{name}[{i}]"), *x)?;
+            }
+        }
+        if let Some(b) = &p.base_tracking {
+            for (name, v) in [("k_c", b.k_c), ("d_c", b.d_c)] {
+                for (i, x) in v.iter().enumerate() {
+                    nonneg("posture.base_tracking.", &format!("{name}[{i}]"), *x)?;
+                }
             }
         }
         nonneg("posture.", "skin_gain", p.skin_gain)

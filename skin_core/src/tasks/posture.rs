@@ -3,15 +3,44 @@
 //! `τ_s = k_skin τ_skin + τ_oca`: the body skin torque of eq. (13)-(14) (patch virtual wrenches,
 //! outward, so `−τ_skin` yields to the touch) and the base avoidance torque of eq. (15)-(17)
 //! ([`super::base_avoidance`], toward the obstacles, so `−τ_oca` moves away).
+//!
+//! A commanded base motion ([`BaseReference`], paper 003 Exp. 1's circle and swings) is this
+//! level's reference: the base joints' `q_post` becomes the moving `q_d(t)` and their damping acts
+//! on `q̇ − q̇_d` (the velocity feed-forward), with the gains of `posture.base_tracking`. Being the
+//! lowest level, the motion only takes the null space of the hand's tasks: the arm keeps the hand.
 
 use nalgebra::DVector;
 
-use super::params::PostureParams;
+use super::params::{BaseTrackingGains, PostureParams};
 use super::TaskError;
 use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::PatchWrench;
 use crate::skin::layout::ResolvedLayout;
 use crate::skin::torques::patch_wrenches_to_torques;
+
+/// A commanded base pose and velocity at one instant: the moving `q_d`, `q̇_d` of the base joints
+/// (world x, y \[m\], yaw \[rad\], as the base joints measure them; yaw unwrapped like the joint).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BaseReference {
+    /// `q_d` of base x, y, yaw.
+    pub position: [f64; 3],
+    /// `q̇_d` of base x, y, yaw (world frame) \[m/s, rad/s\].
+    pub velocity: [f64; 3],
+}
+
+impl BaseReference {
+    /// Index of the first non-finite value (positions 0-2, velocities 3-5), if any.
+    pub fn non_finite(&self) -> Option<usize> {
+        self.position.iter().chain(&self.velocity).position(|v| !v.is_finite())
+    }
+}
+
+/// A base reference with the base joints' model indices.
+#[derive(Debug, Clone, Copy)]
+struct BaseTarget {
+    joints: [usize; 3],
+    reference: BaseReference,
+}
 
 /// Joint compliance / posture torque.
 #[derive(Debug, Clone)]
@@ -24,6 +53,9 @@ pub struct Posture {
     pub skin_gain: f64,
     /// Desired posture `q_post`.
     pub q_post: DVector<f64>,
+    /// Gains of the base joints while a [`BaseReference`] is set (none: `k_c`, `d_c`).
+    pub base_tracking: Option<BaseTrackingGains>,
+    base: Option<BaseTarget>,
     tau_skin: DVector<f64>,
     tau: DVector<f64>,
 }
@@ -44,9 +76,31 @@ impl Posture {
             d_c: expand(&params.d_c, nv, "posture.d_c")?,
             skin_gain: params.skin_gain,
             q_post: expand(q_post, nv, "q_post")?,
+            base_tracking: params.base_tracking,
+            base: None,
             tau_skin: DVector::zeros(nv),
             tau: DVector::zeros(nv),
         })
+    }
+
+    /// Sets the commanded base motion of the base joints `joints` (model indices of x, y, yaw),
+    /// or clears it (`None`: back to `q_post`). A non-finite value or a joint index out of range
+    /// is refused (the previous reference stays).
+    pub fn set_base_reference(&mut self, joints: [usize; 3], reference: Option<BaseReference>) -> Result<(), TaskError> {
+        let nv = self.tau.len();
+        if let Some(&j) = joints.iter().find(|&&j| j >= nv) {
+            return Err(TaskError::Length { what: "base joint index", expected: nv, got: j });
+        }
+        if let Some(index) = reference.and_then(|r| r.non_finite()) {
+            return Err(TaskError::NonFinite { what: "base reference", index });
+        }
+        self.base = reference.map(|reference| BaseTarget { joints, reference });
+        Ok(())
+    }
+
+    /// The commanded base motion in use.
+    pub fn base_reference(&self) -> Option<BaseReference> {
+        self.base.map(|b| b.reference)
     }
 
     /// Computes `τ_c*` at the state of the last `update_kinematics` from the patch wrenches of the
@@ -79,6 +133,15 @@ impl Posture {
             let oca = tau_oca.map_or(0.0, |t| t[i]);
             let compliance = -self.k_c[i] * (q[i] - self.q_post[i]) - self.d_c[i] * qd[i];
             self.tau[i] = joint * compliance - (self.skin_gain * self.tau_skin[i] + oca);
+        }
+        if let Some(b) = &self.base {
+            // q_d(t), q̇_d(t) of the commanded motion in place of q_post, 0 on the base joints
+            for (k, &i) in b.joints.iter().enumerate() {
+                let (kc, dc) = self.base_tracking.map_or((self.k_c[i], self.d_c[i]), |g| (g.k_c[k], g.d_c[k]));
+                let r = &b.reference;
+                let tracking = -kc * (q[i] - r.position[k]) - dc * (qd[i] - r.velocity[k]);
+                self.tau[i] = joint * tracking - (self.skin_gain * self.tau_skin[i] + tau_oca.map_or(0.0, |t| t[i]));
+            }
         }
         Ok(&self.tau)
     }

@@ -13,7 +13,8 @@ use super::hand_force::{HandForce, HandMeasurement};
 use super::params::TaskParams;
 use crate::skin::params::ParamsError;
 use super::position_hold::PositionHold;
-use super::posture::Posture;
+use super::posture::{BaseReference, Posture};
+use super::TaskError;
 use super::tactile_guidance::TactileGuidance;
 use super::wrist::CompliantWrist;
 use crate::hierarchy::{HierarchySolver, InverseParams, TaskLevel};
@@ -291,6 +292,35 @@ fn posture_at_rest_posture_is_pure_damping() {
     for i in 0..nv {
         assert_relative_eq!(tau[i], -posture.d_c[i] * qd[i], epsilon = 1e-12);
     }
+}
+
+#[test]
+fn a_base_reference_replaces_q_post_on_the_base_joints_only() {
+    let mut s = tomm();
+    let nv = s.model.nv();
+    let joints = ["base_x_joint", "base_y_joint", "base_yaw_joint"].map(|n| s.model.joint_index(n).unwrap());
+    let qd: Vec<f64> = (0..nv).map(|i| 0.02 * i as f64 - 0.1).collect();
+    update_kinematics(&s.model, &mut s.data, &s.q, &qd).unwrap();
+    let mut posture = Posture::new(nv, &s.params.posture, &s.q).unwrap();
+    let gains = s.params.posture.base_tracking.expect("config/tasks.yaml has base tracking gains");
+    let wrenches = vec![PatchWrench::default(); s.layout.patches().len()];
+    let reference = BaseReference { position: [0.1, -0.2, 0.05], velocity: [0.03, 0.01, -0.02] };
+    posture.set_base_reference(joints, Some(reference)).unwrap();
+    let tau = posture.update(&s.model, &s.data, &s.layout, &wrenches, |_| true, None, true).unwrap().clone();
+    for i in 0..nv {
+        let expected = match joints.iter().position(|&j| j == i) {
+            // eq. (18) with q_d(t), q̇_d(t) and the tracking gains
+            Some(k) => -gains.k_c[k] * (s.q[i] - reference.position[k]) - gains.d_c[k] * (qd[i] - reference.velocity[k]),
+            None => -posture.d_c[i] * qd[i],
+        };
+        assert_relative_eq!(tau[i], expected, epsilon = 1e-12);
+    }
+    let bad = BaseReference { position: [0.0, f64::INFINITY, 0.0], ..reference };
+    assert!(matches!(posture.set_base_reference(joints, Some(bad)), Err(TaskError::NonFinite { index: 1, .. })));
+    assert!(posture.set_base_reference([0, 1, nv], None).is_err());
+    posture.set_base_reference(joints, None).unwrap();
+    let tau = posture.update(&s.model, &s.data, &s.layout, &wrenches, |_| true, None, true).unwrap()[joints[0]];
+    assert_relative_eq!(tau, -posture.d_c[joints[0]] * qd[joints[0]], epsilon = 1e-12);
 }
 
 #[test]

@@ -1,6 +1,6 @@
 //! Value checks of a scene file that need no robot model: every error names the dotted key.
 
-use super::spec::{ObjectSpec, PersonSpec, PushSpec, SceneSpec, ShapeSpec, SkinSpec, LidarSpec};
+use super::spec::{BaseMotionSpec, ObjectSpec, PersonSpec, PushSpec, SceneSpec, ShapeSpec, SkinSpec, LidarSpec};
 
 /// A rejected value: its dotted key (e.g. `objects[2].shape.box.size_m`) and why.
 #[derive(Debug, Clone, PartialEq)]
@@ -100,7 +100,40 @@ pub(crate) fn check_values(spec: &SceneSpec) -> Checked {
             None => {}
         }
     }
+    for (i, m) in spec.base_motions.iter().enumerate() {
+        check_base_motion(&format!("base_motions[{i}]"), m)?;
+        if i > 0 && m.start_s < spec.base_motions[i - 1].end_s {
+            return Err(reject(format!("base_motions[{i}].start_s"), "before the previous motion's end_s (list them in time order, not overlapping)"));
+        }
+    }
     Ok(())
+}
+
+fn check_base_motion(key: &str, m: &BaseMotionSpec) -> Checked {
+    non_negative(format!("{key}.start_s"), m.start_s)?;
+    if !(m.end_s.is_finite() && m.end_s > m.start_s) {
+        return Err(reject(format!("{key}.end_s"), format!("{} must be after start_s", m.end_s)));
+    }
+    positive(format!("{key}.ramp_s"), m.ramp_s)?;
+    if 2.0 * m.ramp_s > m.end_s - m.start_s {
+        return Err(reject(format!("{key}.ramp_s"), format!("{} s: fade-in and fade-out must fit in the window", m.ramp_s)));
+    }
+    match (&m.circle, &m.swing) {
+        (Some(c), None) => {
+            positive(format!("{key}.circle.radius_m"), c.radius_m)?;
+            positive(format!("{key}.circle.period_s"), c.period_s)
+        }
+        (None, Some(s)) => {
+            positive(format!("{key}.swing.amplitude_m"), s.amplitude_m)?;
+            positive(format!("{key}.swing.period_s"), s.period_s)?;
+            finite(format!("{key}.swing.axis"), &s.axis)?;
+            if s.axis[0].hypot(s.axis[1]) < 1e-9 {
+                return Err(reject(format!("{key}.swing.axis"), "must not be zero"));
+            }
+            Ok(())
+        }
+        _ => Err(reject(key, "give exactly one of `circle` and `swing`")),
+    }
 }
 
 fn unique_name<'a>(key: &str, name: &'a str, names: &mut Vec<&'a str>) -> Checked {

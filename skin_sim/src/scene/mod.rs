@@ -99,6 +99,10 @@ impl Scene {
             .map_err(|e| invalid(reject("robot.urdf", e.to_string())))?;
         let (moving, q0) = joint_setup(&spec.robot, &model).map_err(invalid)?;
         check_frames(&spec, &model).map_err(invalid)?;
+        let base_moves = BASE_JOINTS.iter().filter_map(|b| model.joint_index(b)).any(|j| moving[j]);
+        if !spec.base_motions.is_empty() && !base_moves {
+            return Err(invalid(reject("base_motions", "the scene's base does not move (keep the base joints in robot.joints)")));
+        }
         let skin = match &spec.skin {
             Some(s) => Some(load_skin(s, dir, &model).map_err(invalid)?),
             None => None,

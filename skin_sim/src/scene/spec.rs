@@ -33,6 +33,10 @@ pub struct SceneSpec {
     /// Contact force references for the controller (data only).
     #[serde(default)]
     pub force_references: Vec<ForceReferenceSpec>,
+    /// Commanded base motions for the controller (paper 003 Exp. 1), relative to the base pose
+    /// at the first one's start; they count as interaction periods of the metrics.
+    #[serde(default)]
+    pub base_motions: Vec<BaseMotionSpec>,
     /// Length of a run \[s\].
     pub duration_s: f64,
     /// MuJoCo integration step \[s\]; every other period is a multiple of it.
@@ -321,6 +325,55 @@ pub struct ForceReferenceSpec {
     /// Period \[s\] (required when the amplitude is not 0).
     #[serde(default)]
     pub period_s: Option<f64>,
+}
+
+/// A commanded base motion during `[start_s, end_s)` (paper 003 Exp. 1: a circle, then lateral
+/// swings), an offset of the base's x, y from the pose the base had when the first motion
+/// started (its yaw is held). The offset's size is faded in over `ramp_s` after the start and
+/// out over `ramp_s` before the end (a C¹ smoothstep), so the commanded position and velocity
+/// have no step. Exactly one of `circle`, `swing`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BaseMotionSpec {
+    /// Start of the window \[s\].
+    pub start_s: f64,
+    /// End of the window \[s\].
+    pub end_s: f64,
+    /// Fade-in and fade-out time \[s\] (at most half the window).
+    #[serde(default = "default_ramp")]
+    pub ramp_s: f64,
+    /// A circle about the start pose.
+    #[serde(default)]
+    pub circle: Option<CircleSpec>,
+    /// Swings to and fro along an axis through the start pose.
+    #[serde(default)]
+    pub swing: Option<SwingSpec>,
+}
+
+fn default_ramp() -> f64 {
+    5.0
+}
+
+/// A circle about the start pose, counter-clockwise seen from above, starting along +x.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CircleSpec {
+    /// Radius \[m\].
+    pub radius_m: f64,
+    /// Time of one turn \[s\] (base speed `2π radius / period`).
+    pub period_s: f64,
+}
+
+/// `amplitude sin(2π (t − start) / period)` along a world-frame axis through the start pose.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SwingSpec {
+    /// Amplitude \[m\].
+    pub amplitude_m: f64,
+    /// Period of one swing to and fro \[s\] (peak speed `2π amplitude / period`).
+    pub period_s: f64,
+    /// World-frame direction (x, y), normalized on use.
+    pub axis: [f64; 2],
 }
 
 impl ForceReferenceSpec {

@@ -16,8 +16,8 @@ pub struct CycleRecord {
     pub qd: Vec<f64>,
     /// Commanded arm joint velocities, in [`RunRecord::arm_joints`] order \[rad/s or m/s\].
     pub joint_velocities: Vec<f64>,
-    /// Commanded base twist `(vx, vy, wz)` in the base frame (the controller's plus any scripted
-    /// base motion of the scene).
+    /// Commanded base twist `(vx, vy, wz)` in the base frame (a scene's base motion is the
+    /// controller's reference, so it is in here, not added to it).
     pub base_twist: [f64; 3],
     /// Active arrangement (paper 000 Table I / paper 003 Table 1).
     pub mode: Mode,

@@ -62,11 +62,6 @@ impl BaseMotions {
         BaseMotions { motions: motions.to_vec(), origin: None }
     }
 
-    /// The windows `[start, end)` of the motions.
-    pub fn windows(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
-        self.motions.iter().map(|m| (m.start_s, m.end_s))
-    }
-
     /// The reference at `t_s`, with `base_q` the measured base x, y, yaw: None before the first
     /// motion starts (the posture's `q_post`); from then on the pose the base had at that start
     /// (captured then, so the reference starts where the base is) plus the active motion's
@@ -154,6 +149,5 @@ mod tests {
         // later measurements do not move the origin
         let r = motions.reference(95.0, [1.0, 1.0, 1.0]).unwrap();
         assert!(r.position.iter().zip(&start).all(|(a, b)| (a - b).abs() < 1e-12));
-        assert_eq!(motions.windows().collect::<Vec<_>>(), [(15.0, 50.0), (50.0, 90.0)]);
     }
 }

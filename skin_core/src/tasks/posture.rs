@@ -131,19 +131,22 @@ impl Posture {
         let joint = if joint { 1.0 } else { 0.0 };
         for i in 0..nv {
             let oca = tau_oca.map_or(0.0, |t| t[i]);
-            let compliance = -self.k_c[i] * (q[i] - self.q_post[i]) - self.d_c[i] * qd[i];
-            self.tau[i] = joint * compliance - (self.skin_gain * self.tau_skin[i] + oca);
-        }
-        if let Some(b) = &self.base {
-            // q_d(t), q̇_d(t) of the commanded motion in place of q_post, 0 on the base joints
-            for (k, &i) in b.joints.iter().enumerate() {
-                let (kc, dc) = self.base_tracking.map_or((self.k_c[i], self.d_c[i]), |g| (g.k_c[k], g.d_c[k]));
-                let r = &b.reference;
-                let tracking = -kc * (q[i] - r.position[k]) - dc * (qd[i] - r.velocity[k]);
-                self.tau[i] = joint * tracking - (self.skin_gain * self.tau_skin[i] + tau_oca.map_or(0.0, |t| t[i]));
-            }
+            self.tau[i] = joint * self.compliance(i, q[i], qd[i]) - (self.skin_gain * self.tau_skin[i] + oca);
         }
         Ok(&self.tau)
+    }
+
+    /// Joint `i`'s compliance at `q`, `q̇`: `−K_c (q − q_post) − D_c q̇`, or on a base joint with a
+    /// [`BaseReference`] set `−K_c (q − q_d) − D_c (q̇ − q̇_d)` with the `base_tracking` gains.
+    fn compliance(&self, i: usize, q: f64, qd: f64) -> f64 {
+        let tracked = self.base.and_then(|b| b.joints.iter().position(|&j| j == i).map(|k| (b.reference, k)));
+        match tracked {
+            Some((r, k)) => {
+                let (kc, dc) = self.base_tracking.map_or((self.k_c[i], self.d_c[i]), |g| (g.k_c[k], g.d_c[k]));
+                -kc * (q - r.position[k]) - dc * (qd - r.velocity[k])
+            }
+            None => -self.k_c[i] * (q - self.q_post[i]) - self.d_c[i] * qd,
+        }
     }
 
     /// Zeroes the last update's torque on the joints marked in `locked` (joints held still).

@@ -159,10 +159,15 @@ pub fn compute(record: &RunRecord, scene: &Scene, limits: Limits) -> Metrics {
         goal: (!scene.spec.goals.is_empty()).then(|| goal_metrics(cycles, scene, limits)),
         force: (!scene.spec.force_references.is_empty()).then(|| force_metrics(cycles)),
         contact_free: (scene.spec.goals.is_empty() && scene.spec.force_references.is_empty()).then(|| ContactFreeMetrics {
-            max_link_contact_n: cycles.iter().map(|c| c.link_force_n).fold(0.0, f64::max),
+            max_link_contact_n: max_link_force(cycles, |_| true),
             eps_c_n: limits.eps_c_n,
         }),
     }
+}
+
+/// The largest physical contact force on one link over the cycles that `keep` selects \[N\].
+fn max_link_force(cycles: &[CycleRecord], keep: impl Fn(&CycleRecord) -> bool) -> f64 {
+    cycles.iter().filter(|c| keep(c)).map(|c| c.link_force_n).fold(0.0, f64::max)
 }
 
 fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: Limits) -> GoalMetrics {
@@ -175,9 +180,6 @@ fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: Limits) -> GoalMe
         .map(|p| (p.start_s, p.end_s))
         .collect();
     let excused = |t: f64| pushes.iter().any(|&(a, b)| t >= a && t < b + RECOVERY_LIMIT_S);
-    let max_force = |keep: &dyn Fn(&CycleRecord) -> bool| {
-        cycles.iter().filter(|c| keep(c)).map(|c| c.link_force_n).fold(0.0, f64::max)
-    };
     let recovery = pushes
         .iter()
         .map(|&(_, end)| {
@@ -191,8 +193,8 @@ fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: Limits) -> GoalMe
         goal_reached: error <= limits.goal_tolerance_m,
         goal_error_m: error,
         goal_tolerance_m: limits.goal_tolerance_m,
-        max_contact_force_intentional_n: max_force(&|c| c.mode == Mode::IntentionalContact && !excused(c.t_s)),
-        max_contact_force_n: max_force(&|c| !excused(c.t_s)),
+        max_contact_force_intentional_n: max_link_force(cycles, |c| c.mode == Mode::IntentionalContact && !excused(c.t_s)),
+        max_contact_force_n: max_link_force(cycles, |c| !excused(c.t_s)),
         eps_c_n: eps,
         hard_contact_recovery_s: recovery,
     }

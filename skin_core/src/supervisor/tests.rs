@@ -57,6 +57,14 @@ fn stuck() -> SupervisorInput {
 }
 
 /// Drives the paper 000 supervisor into (b).
+/// A supervisor of `p` driven from (a) into (b), and the time it got there.
+fn in_b(p: &SupervisorParams) -> (Supervisor, f64) {
+    let mut sup = Supervisor::new(p, 0.0).unwrap();
+    let mut t = 0.0;
+    into_b(&mut sup, &mut t);
+    (sup, t)
+}
+
 fn into_b(sup: &mut Supervisor, t: &mut f64) {
     let tr = run(sup, t, 200, stuck());
     assert_eq!(tr.len(), 1, "{tr:?}");
@@ -116,9 +124,7 @@ fn no_switch_to_b_when_moving_or_clear_or_at_goal() {
 #[test]
 fn contact_over_limit_b_to_c_and_release_back_to_b() {
     let p = params();
-    let mut sup = Supervisor::new(&p, 0.0).unwrap();
-    let mut t = 0.0;
-    into_b(&mut sup, &mut t);
+    let (mut sup, mut t) = in_b(&p);
     let tr = run(&mut sup, &mut t, 10, input(0.0, 0.0, 6.0, 0.2));
     assert_eq!(tr.len(), 1);
     assert_eq!(
@@ -162,9 +168,7 @@ fn goal_reached_or_cleared_b_to_a() {
         (input(0.05, 0.0, 0.0, 0.2), Cause::ObstacleCleared),
         (input(f64::NAN, 3.0, 0.0, 0.2), Cause::InvalidInput),
     ] {
-        let mut sup = Supervisor::new(&p, 0.0).unwrap();
-        let mut t = 0.0;
-        into_b(&mut sup, &mut t);
+        let (mut sup, mut t) = in_b(&p);
         let tr = run(&mut sup, &mut t, 300, u);
         assert_eq!(tr.len(), 1, "{u:?}");
         assert_eq!(
@@ -180,9 +184,7 @@ fn goal_reached_or_cleared_b_to_a() {
 #[test]
 fn goal_reached_with_an_obstacle_in_range_stays_in_b() {
     let p = params();
-    let mut sup = Supervisor::new(&p, 0.0).unwrap();
-    let mut t = 0.0;
-    into_b(&mut sup, &mut t);
+    let (mut sup, mut t) = in_b(&p);
     assert!(run(&mut sup, &mut t, 1000, input(0.0, 3.0, 0.0, 0.0)).is_empty());
     let tr = run(&mut sup, &mut t, 300, input(0.0, 0.0, 0.0, 0.0));
     assert_eq!(tr.len(), 1, "{tr:?}");
@@ -193,9 +195,7 @@ fn goal_reached_with_an_obstacle_in_range_stays_in_b() {
 fn sensing_range_shrinks_gradually_in_b_and_is_restored_in_a() {
     let p = params();
     let r = p.sensing_range;
-    let mut sup = Supervisor::new(&p, 0.0).unwrap();
-    let mut t = 0.0;
-    into_b(&mut sup, &mut t);
+    let (mut sup, mut t) = in_b(&p);
     let mut prev = sup.arrangement().sensing_range_m;
     let mut hit_zero_at = None;
     for _ in 0..1000 {
@@ -249,9 +249,7 @@ fn noise_around_thresholds_does_not_chatter() {
     assert!(count <= 1, "speed noise: {count}");
 
     // Contact force around eps_c in (b): one (b) -> (c), never back (band 30 % > noise).
-    let mut sup = Supervisor::new(&p, 0.0).unwrap();
-    let mut t = 0.0;
-    into_b(&mut sup, &mut t);
+    let (mut sup, mut t) = in_b(&p);
     let base = sup.log().total();
     for _ in 0..n {
         t += DT;
@@ -272,9 +270,7 @@ fn noise_around_thresholds_does_not_chatter() {
     assert!(sup.log().total() - base <= 1, "release noise");
 
     // Goal error around the tolerance in (b): at most one (b) -> (a), no re-entry.
-    let mut sup = Supervisor::new(&p, 0.0).unwrap();
-    let mut t = 0.0;
-    into_b(&mut sup, &mut t);
+    let (mut sup, mut t) = in_b(&p);
     let base = sup.log().total();
     for _ in 0..n {
         t += DT;
@@ -442,9 +438,7 @@ fn switching_does_not_reallocate_task_order() {
 fn log_ring_buffer_keeps_latest() {
     let mut p = params();
     p.log_capacity = 2;
-    let mut sup = Supervisor::new(&p, 0.0).unwrap();
-    let mut t = 0.0;
-    into_b(&mut sup, &mut t); // a -> b
+    let (mut sup, mut t) = in_b(&p); // a -> b
     run(&mut sup, &mut t, 1, input(0.0, 3.0, 9.0, 0.2)); // b -> c
     run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2)); // c -> b
     assert_eq!(sup.log().total(), 3);

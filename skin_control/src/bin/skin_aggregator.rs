@@ -12,7 +12,8 @@ use r2r::{ParameterValue, RosParams};
 use skin_control::aggregator::{Aggregator, SKIN_PARAM_DESCRIPTIONS};
 use skin_control::convert::IssueKind;
 use skin_control::ros_params::StructParams;
-use skin_control::{markers, paths, qos, shutdown};
+use skin_control::nodes::{self, file_setting, resolve};
+use skin_control::{markers, qos, shutdown};
 use skin_core::model::RobotModel;
 use skin_core::skin::layout::{ResolvedLayout, SkinLayout};
 use skin_core::skin::params::SkinParams;
@@ -46,23 +47,8 @@ struct Args {
     /// Skin model parameter file (initial parameter values) [default: config/skin_model.yaml].
     #[arg(long, value_name = "FILE")]
     skin_model: Option<String>,
-}
-
-/// A start-up file: the command-line option, else the ROS parameter, else the default.
-fn file_setting(
-    node: &r2r::Node,
-    option: Option<String>,
-    key: &str,
-    default: &str,
-) -> Result<String> {
-    let param: Option<String> = node
-        .get_parameter(key)
-        .with_context(|| format!("ROS parameter `{key}`"))?;
-    Ok(option.or(param).unwrap_or_else(|| default.to_string()))
-}
-
-fn resolve(setting: &str, what: &str) -> Result<std::path::PathBuf> {
-    paths::resolve(setting).map_err(|e| anyhow::anyhow!("{what}: {e}"))
+    #[command(flatten)]
+    wait: nodes::SubscriberWait,
 }
 
 struct Setup {
@@ -142,6 +128,7 @@ fn main() -> Result<()> {
     let ctx = r2r::Context::create()?;
     let mut node = r2r::Node::create(ctx, NODE, "")?;
     let logger = node.logger().to_string();
+    let args_wait = args.wait.clone();
     let Setup { layout, params } = setup(&node, args)?;
     let params = Arc::new(Mutex::new(params));
     let served: Arc<Mutex<dyn RosParams + Send>> = params.clone();
@@ -161,6 +148,12 @@ fn main() -> Result<()> {
         layout.patches().len(),
         layout.num_cells()
     );
+
+    args_wait.wait(NODE, &[PATCHES_TOPIC.into(), MARKERS_TOPIC.into()], |topic| match topic {
+        PATCHES_TOPIC => Some(patches_pub.get_inter_process_subscription_count()),
+        MARKERS_TOPIC => Some(markers_pub.get_inter_process_subscription_count()),
+        _ => None,
+    })?;
 
     let mut pool = LocalPool::new();
     let spawner = pool.spawner();

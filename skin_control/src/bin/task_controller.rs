@@ -21,6 +21,8 @@ use skin_control::shutdown;
 struct Args {
     #[command(flatten)]
     options: task_controller::Options,
+    #[command(flatten)]
+    wait: nodes::SubscriberWait,
 }
 
 fn main() -> Result<()> {
@@ -30,6 +32,7 @@ fn main() -> Result<()> {
     let mut node = r2r::Node::create(ctx, task_controller::NODE, "")?;
     let mut pool = LocalPool::new();
     let handle = task_controller::start(&mut node, &pool.spawner(), args.options)?;
+    args.wait.wait(task_controller::NODE, &handle.output_topics(), |t| handle.subscription_count(t))?;
     nodes::spin(&mut node, &mut pool, || {
         handle.poll();
         Pass::Idle

@@ -123,6 +123,71 @@ pub fn cli_args() -> impl Iterator<Item = String> {
     std::env::args().take_while(|a| a != "--ros-args")
 }
 
+/// `--wait-topic-subscribers` of a node whose outputs a recording must hold from the first
+/// message on.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct SubscriberWait {
+    /// Before taking any input, wait (at most 30 s) until TOPIC (an output of this node) has N
+    /// matched subscribers in other processes, then print `ready` on stdout; e.g.
+    /// `/skin/patches=1` when a recorder must get the first message (a volatile publisher drops
+    /// what it sends before discovery has matched a subscriber).
+    #[arg(long, num_args = 1.., value_name = "TOPIC=N", value_parser = crate::rosbag::play::topic_count)]
+    pub wait_topic_subscribers: Vec<(String, usize)>,
+}
+
+impl SubscriberWait {
+    /// Waits as asked (nothing when nothing was asked); `count` gives an output topic's matched
+    /// subscribers (`None`: not an output of the node, named in the error with `outputs`).
+    pub fn wait(&self, node: &str, outputs: &[String], count: impl Fn(&str) -> Option<r2r::Result<usize>>) -> Result<()> {
+        if self.wait_topic_subscribers.is_empty() {
+            return Ok(());
+        }
+        let lacking = wait_for_subscribers(&self.wait_topic_subscribers, count, Duration::from_secs(30))
+            .map_err(|e| anyhow::anyhow!("--wait-topic-subscribers: {e} (outputs: {})", outputs.join(", ")))?;
+        if lacking.is_empty() {
+            println!("{node}: ready (subscribers matched)");
+        } else {
+            println!("{node}: after 30 s too few subscribers on {}: starting anyway", lacking.join(", "));
+        }
+        use std::io::Write as _;
+        std::io::stdout().flush().context("stdout")
+    }
+}
+
+/// The topics of `wanted` (`TOPIC`, N) with fewer than N matched subscribers in other processes,
+/// as `TOPIC (n of N)`; `count` gives a topic's count (`None`: not a topic of the caller, an
+/// error).
+pub fn lacking_subscribers(wanted: &[(String, usize)], count: impl Fn(&str) -> Option<r2r::Result<usize>>) -> Result<Vec<String>> {
+    let mut lacking = Vec::new();
+    for (topic, n_wanted) in wanted {
+        let n = count(topic)
+            .ok_or_else(|| anyhow::anyhow!("`{topic}` is not published here"))?
+            .with_context(|| format!("{topic}: subscription count"))?;
+        if n < *n_wanted {
+            lacking.push(format!("{topic} ({n} of {n_wanted})"));
+        }
+    }
+    Ok(lacking)
+}
+
+/// [`lacking_subscribers`] polled every 10 ms until none lack or `timeout` has passed (or a
+/// stop was requested); returns the ones still lacking. Matching is DDS's work: the node need
+/// not spin (and does not take inputs meanwhile).
+pub fn wait_for_subscribers(
+    wanted: &[(String, usize)],
+    count: impl Fn(&str) -> Option<r2r::Result<usize>>,
+    timeout: Duration,
+) -> Result<Vec<String>> {
+    let deadline = std::time::Instant::now() + timeout;
+    loop {
+        let lacking = lacking_subscribers(wanted, &count)?;
+        if lacking.is_empty() || std::time::Instant::now() > deadline || crate::shutdown::requested() {
+            return Ok(lacking);
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
 /// What a node's poll in [`spin_nodes`] did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Pass {

@@ -185,21 +185,17 @@ impl SimHandle {
     /// with a warning naming them).
     fn lacking_subscribers(&self) -> Result<bool> {
         let p = &self.pubs;
-        let mut lacking = Vec::new();
-        for (topic, wanted) in &self.options.wait_topic_subscribers {
-            let n = match topic.as_str() {
-                JOINT_STATES => p.joints.get_inter_process_subscription_count(),
-                CELLS => p.cells.get_inter_process_subscription_count(),
-                ODOM => p.odom.get_inter_process_subscription_count(),
-                SCAN => p.scan.get_inter_process_subscription_count(),
-                CLOCK => p.clock.get_inter_process_subscription_count(),
-                _ => anyhow::bail!("--wait-topic-subscribers: `{topic}` is not an input topic ({JOINT_STATES}, {CELLS}, {ODOM}, {SCAN}, {CLOCK})"),
-            }
-            .with_context(|| format!("{topic}: subscription count"))?;
-            if n < *wanted {
-                lacking.push(format!("{topic} ({n} of {wanted})"));
-            }
-        }
+        let count = |topic: &str| match topic {
+            JOINT_STATES => Some(p.joints.get_inter_process_subscription_count()),
+            CELLS => Some(p.cells.get_inter_process_subscription_count()),
+            ODOM => Some(p.odom.get_inter_process_subscription_count()),
+            SCAN => Some(p.scan.get_inter_process_subscription_count()),
+            CLOCK => Some(p.clock.get_inter_process_subscription_count()),
+            _ => None,
+        };
+        let lacking = super::lacking_subscribers(&self.options.wait_topic_subscribers, count).map_err(|e| {
+            anyhow::anyhow!("--wait-topic-subscribers: {e} (inputs: {JOINT_STATES}, {CELLS}, {ODOM}, {SCAN}, {CLOCK})")
+        })?;
         if !lacking.is_empty() && self.started.elapsed() > Duration::from_secs(30) {
             r2r::log_warn!(&self.logger, "after 30 s too few subscribers on {}: starting anyway", lacking.join(", "));
             return Ok(false);

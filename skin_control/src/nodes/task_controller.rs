@@ -143,6 +143,26 @@ impl TaskControllerHandle {
         self.shared.borrow_mut().maybe_cycle();
     }
 
+    /// The output topics (arm commands, base twist if any, controller state).
+    pub fn output_topics(&self) -> Vec<String> {
+        let s = self.shared.borrow();
+        let mut out = s.topics.clone();
+        out.extend(s.pubs.base.as_ref().map(|_| CMD_VEL.to_string()));
+        out.push(CONTROLLER_STATE.into());
+        out
+    }
+
+    /// Matched subscribers in other processes of an output topic (`None`: not an output).
+    pub fn subscription_count(&self, topic: &str) -> Option<r2r::Result<usize>> {
+        let s = self.shared.borrow();
+        let p = &s.pubs;
+        match topic {
+            CMD_VEL => p.base.as_ref().map(|b| b.get_inter_process_subscription_count()),
+            CONTROLLER_STATE => Some(p.state.get_inter_process_subscription_count()),
+            _ => s.topics.iter().position(|t| t == topic).map(|k| p.arms[k].get_inter_process_subscription_count()),
+        }
+    }
+
     /// The controller's counts (cycles, safe-stop steps).
     pub fn counts(&self) -> (u64, u64) {
         self.shared.borrow().tc.counts()

@@ -138,7 +138,7 @@ pub fn play(options: PlayOptions) -> Result<()> {
         None => None,
     };
 
-    wait_for_subscribers(&mut node, &pubs, &options)?;
+    wait_for_subscribers(&pubs, &options)?;
     let send = |i: usize| -> Result<()> {
         let m = &bag.messages[i];
         pubs[&m.topic].publish_raw(&m.data).with_context(|| format!("{}: publishing", m.topic))
@@ -220,28 +220,20 @@ pub(crate) fn topic_count(s: &str) -> Result<(String, usize), String> {
 /// Waits until every publisher has its number of inter-process subscribers
 /// (`--wait-topic-subscribers`, else `--wait-subscribers`), or the timeout (then warns naming
 /// the topics without them).
-fn wait_for_subscribers(node: &mut r2r::Node, pubs: &BTreeMap<String, r2r::PublisherUntyped>, options: &PlayOptions) -> Result<()> {
-    let wanted = |topic: &str| {
-        options.wait_topic_subscribers.iter().find(|(t, _)| t == topic).map_or(options.wait_subscribers, |(_, n)| *n)
-    };
-    let deadline = Instant::now() + Duration::from_secs_f64(options.wait_timeout);
-    loop {
-        let mut lacking = Vec::new();
-        for (name, p) in pubs {
-            let n = p.get_inter_process_subscription_count().with_context(|| format!("{name}: subscription count"))?;
-            if n < wanted(name) {
-                lacking.push(format!("{name} ({n} of {})", wanted(name)));
-            }
-        }
-        if lacking.is_empty() || shutdown::requested() {
-            return Ok(());
-        }
-        if Instant::now() > deadline {
-            eprintln!("skin_bag: after {} s, too few subscribers on {}: starting anyway", options.wait_timeout, lacking.join(", "));
-            return Ok(());
-        }
-        node.spin_once(Duration::from_millis(20));
+fn wait_for_subscribers(pubs: &BTreeMap<String, r2r::PublisherUntyped>, options: &PlayOptions) -> Result<()> {
+    let wanted: Vec<(String, usize)> = pubs
+        .keys()
+        .map(|name| {
+            let n = options.wait_topic_subscribers.iter().find(|(t, _)| t == name).map_or(options.wait_subscribers, |(_, n)| *n);
+            (name.clone(), n)
+        })
+        .collect();
+    let count = |topic: &str| pubs.get(topic).map(|p| p.get_inter_process_subscription_count());
+    let lacking = crate::nodes::wait_for_subscribers(&wanted, count, Duration::from_secs_f64(options.wait_timeout))?;
+    if !lacking.is_empty() && !shutdown::requested() {
+        eprintln!("skin_bag: after {} s, too few subscribers on {}: starting anyway", options.wait_timeout, lacking.join(", "));
     }
+    Ok(())
 }
 
 /// Spins until a live answer with a stamp >= `stamp` has arrived.

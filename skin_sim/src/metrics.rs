@@ -61,14 +61,28 @@ pub struct Metrics {
     pub contact_free: Option<ContactFreeMetrics>,
 }
 
-/// A scene in which the robot should touch nothing: its largest contact against `ε_c`.
+/// A scene in which the robot should touch nothing (paper 003 Exp. 2): its largest contact
+/// against `ε_c`, how well the hand keeps `d_p,d` ahead of the surface, and how far the user's
+/// touches on the arm guide it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ContactFreeMetrics {
     /// Largest physical contact force of the environment on one robot link, whole run \[N\].
     pub max_link_contact_n: f64,
     /// `ε_c` of the supervisor \[N\].
     pub eps_c_n: f64,
+    /// `d_p,d` of the hand distance task \[m\].
+    pub hand_distance_desired_m: f64,
+    /// RMS of the hand's distance to the surface ahead (MuJoCo) − `d_p,d`, from the first cycle
+    /// within [`DISTANCE_SETTLED_M`] of it to the end \[m\] (null: never there); a cycle with
+    /// nothing ahead counts with the sensing range as its distance.
+    pub hand_distance_rms_error_m: f64,
+    /// Largest displacement of the hand over one touch on the arm (from the touch's start to
+    /// [`INTERACTION_TAIL_S`] after its end) \[m\] (null: no touch).
+    pub hand_guided_m: f64,
 }
+
+/// The hand counts as arrived at `d_p,d` once it is this close to it \[m\].
+pub const DISTANCE_SETTLED_M: f64 = 0.005;
 
 /// Paper 000: the goal and the contact forces against `ε_c`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -114,6 +128,8 @@ pub struct Limits {
     pub eps_c_n: f64,
     /// Goal tolerance \[m\].
     pub goal_tolerance_m: f64,
+    /// `d_p,d` of the hand distance task \[m\].
+    pub hand_distance_desired_m: f64,
 }
 
 fn rms(values: impl Iterator<Item = f64>) -> (f64, usize) {
@@ -158,10 +174,35 @@ pub fn compute(record: &RunRecord, scene: &Scene, limits: Limits) -> Metrics {
         faulted_cycles: cycles.iter().filter(|c| c.fault.is_some()).count(),
         goal: (!scene.spec.goals.is_empty()).then(|| goal_metrics(cycles, scene, limits)),
         force: (!scene.spec.force_references.is_empty()).then(|| force_metrics(cycles)),
-        contact_free: (scene.spec.goals.is_empty() && scene.spec.force_references.is_empty()).then(|| ContactFreeMetrics {
-            max_link_contact_n: max_link_force(cycles, |_| true),
-            eps_c_n: limits.eps_c_n,
-        }),
+        contact_free: (scene.spec.goals.is_empty() && scene.spec.force_references.is_empty())
+            .then(|| contact_free_metrics(cycles, scene, limits)),
+    }
+}
+
+fn contact_free_metrics(cycles: &[CycleRecord], scene: &Scene, limits: Limits) -> ContactFreeMetrics {
+    let desired = limits.hand_distance_desired_m;
+    let range = scene.skin.as_ref().map_or(f64::INFINITY, |s| s.params.proximity.range_m);
+    let error = |c: &CycleRecord| c.hand_distance_m.min(range) - desired;
+    let settled = cycles.iter().position(|c| error(c).abs() < DISTANCE_SETTLED_M);
+    let (rms_error, _) = match settled {
+        Some(k) => rms(cycles[k..].iter().map(error)),
+        None => (f64::NAN, 0),
+    };
+    let at = |t: f64| cycles.iter().find(|c| c.t_s >= t).or(cycles.last()).map(|c| c.hand_position_m);
+    let guided = scene
+        .spec
+        .pushes
+        .iter()
+        .filter(|p| p.link.is_some())
+        .filter_map(|p| Some((at(p.start_s)?, at(p.end_s + INTERACTION_TAIL_S)?)))
+        .map(|(a, b)| ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt())
+        .fold(f64::NAN, f64::max);
+    ContactFreeMetrics {
+        max_link_contact_n: max_link_force(cycles, |_| true),
+        eps_c_n: limits.eps_c_n,
+        hand_distance_desired_m: desired,
+        hand_distance_rms_error_m: rms_error,
+        hand_guided_m: guided,
     }
 }
 

@@ -24,10 +24,26 @@ fn at_most(name: &'static str, value: f64, limit: f64, unit: &str) -> Check {
     }
 }
 
+fn at_least(name: &'static str, value: f64, limit: f64, unit: &str) -> Check {
+    Check {
+        name,
+        detail: format!("{value:.3} {unit} (at least {limit} {unit})"),
+        passed: value >= limit,
+    }
+}
+
+/// Largest RMS error of the hand's distance to the surface against `d_p,d` in a guidance scene
+/// \[m\] (a third of the paper's 3 cm).
+pub const DISTANCE_RMS_LIMIT_M: f64 = 0.01;
+/// Smallest hand displacement one touch on the arm must cause in a guidance scene \[m\]: the
+/// paper's user moves the hand by tens of centimetres (Fig. 6c).
+pub const GUIDED_MIN_M: f64 = 0.05;
+
 /// The checks of a run: no faulted cycle; paper 000 scenes: goal reached, every contact at most
 /// `ε_c` outside the pushes, pushes relieved within [`RECOVERY_LIMIT_S`]; paper 003 scenes with
-/// `targets`: the RMS force errors of Table 3; scenes with neither goals nor force references:
-/// no link contact above `ε_c`.
+/// `targets`: the RMS force errors of Table 3; scenes with neither goals nor force references
+/// (paper 003 Exp. 2): no link contact above `ε_c`, the hand at `d_p,d` (when it is not 0) and
+/// moved by the touches on the arm (when there are some).
 pub fn checks(m: &Metrics, targets: Option<ForceTargets>) -> Vec<Check> {
     let mut out = vec![Check {
         name: "no safe-stop cycles",
@@ -43,6 +59,12 @@ pub fn checks(m: &Metrics, targets: Option<ForceTargets>) -> Vec<Check> {
     }
     if let Some(c) = &m.contact_free {
         out.push(at_most("no link presses on anything (<= eps_c)", c.max_link_contact_n, c.eps_c_n, "N"));
+        if c.hand_distance_desired_m > 0.0 {
+            out.push(at_most("hand keeps d_p,d (RMS error)", c.hand_distance_rms_error_m, DISTANCE_RMS_LIMIT_M, "m"));
+        }
+        if !c.hand_guided_m.is_nan() {
+            out.push(at_least("touches on the arm guide the hand", c.hand_guided_m, GUIDED_MIN_M, "m"));
+        }
     }
     if let (Some(f), Some(t)) = (&m.force, targets) {
         out.push(at_most("RMS force error w/o interaction", f.rms_force_error_n, t.rms_without_n, "N"));

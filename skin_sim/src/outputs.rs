@@ -4,13 +4,14 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use skin_core::resolver::BASE_JOINTS;
 use skin_core::supervisor::Mode;
 
 use crate::bag::msgs::{
     Arrangement, Clock, ControllerState, Float64MultiArray, Header, JointState, Time, Twist, Vector3,
 };
 use crate::bag::BagWriter;
-use crate::plot::{intervals_where, paper000_figure, paper003_figure, Paper000Signals, Paper003Signals};
+use crate::plot::{guidance_figure, intervals_where, paper000_figure, paper003_figure, GuidanceSignals, Paper000Signals, Paper003Signals};
 use crate::record::{CycleRecord, RunRecord};
 use crate::report::{MetricsJson, RunOutput, RunReport, SummaryText};
 
@@ -19,7 +20,9 @@ use crate::report::{MetricsJson, RunOutput, RunReport, SummaryText};
 pub const ALL: [&dyn RunOutput; 4] = [&MetricsJson, &SummaryText, &FigurePng, &RunBag];
 
 /// `figure.png`: paper 000's panels (arrangement, ee speed, proximity and contact force, torque)
-/// for a paper 000 scenario, paper 003's force-tracking panels for a scene of paper 003's phases.
+/// for a paper 000 scenario, paper 003's force-tracking panels for a scene of paper 003's phases
+/// with force references, its Fig. 6 panels (hand distance, hand and base positions) for one
+/// without (Exp. 2).
 pub struct FigurePng;
 
 fn column(cycles: &[CycleRecord], f: impl Fn(&CycleRecord) -> f64) -> Vec<f64> {
@@ -38,7 +41,23 @@ impl RunOutput for FigurePng {
         let title = format!("{} (seed {}, {})", r.name, r.seed, scene);
         // Paper 003's phases (force tracking or the pre-contact approach) or paper 000's Table I.
         let phases = c.iter().any(|c| matches!(c.mode, Mode::PreContact | Mode::Contact));
-        let figure = if phases {
+        let force_reference = c.iter().any(|c| !c.force_reference_n.is_nan());
+        let figure = if phases && !force_reference {
+            let base = |k: usize| r.joint_names.iter().position(|j| j == BASE_JOINTS[k]).map_or_else(|| vec![f64::NAN; c.len()], |j| column(c, |c| c.q[j]));
+            let hand = |k: usize| column(c, |c| c.hand_position_m[k]);
+            let distance = column(c, |c| if c.hand_distance_m.is_finite() { c.hand_distance_m } else { f64::NAN });
+            guidance_figure(
+                &title,
+                &GuidanceSignals {
+                    t: &t,
+                    distance: &distance,
+                    distance_desired: &vec![r.hand_distance_desired_m; c.len()],
+                    hand: [&hand(0), &hand(1), &hand(2)],
+                    base: [&base(0), &base(1)],
+                    interaction: &interactions,
+                },
+            )
+        } else if phases {
             let phase: Vec<usize> = c.iter().map(|c| usize::from(c.mode == Mode::Contact)).collect();
             let base_speed = column(c, |c| c.base_twist[0].hypot(c.base_twist[1]));
             paper003_figure(

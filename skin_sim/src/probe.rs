@@ -1,21 +1,27 @@
-//! Physical contact forces read from MuJoCo's contacts (ground truth, not the skin): the force
-//! pressing on the hand (paper 003's `f_c` in newtons) and the largest force on one robot link
-//! (paper 000's `‖F_c‖` against `ε_c`).
+//! Ground truth from MuJoCo, not from the skin: the force pressing on the hand (paper 003's `f_c`
+//! in newtons), the largest force on one robot link (paper 000's `‖F_c‖` against `ε_c`), and where
+//! the hand is (its position and its distance `d_p` to the surface ahead of the palm, paper 003
+//! Fig. 6).
 
 use mujoco_rs::mujoco_c;
 use nalgebra::Vector3;
 
 use crate::frames::FrameRef;
-use crate::mjcf::ROBOT_GROUP;
+use crate::mjcf::{ROBOT_GROUP, SENSED_GROUPS};
 use crate::world::World;
 
-/// Contact forces on the robot at the world's current state.
+/// Contact forces on the robot and the hand's place at the world's current state.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ContactForces {
+pub struct ProbeReadings {
     /// Environment force pressing on the hand body along `-z_h` (into the palm) \[N\].
     pub hand_n: f64,
     /// Largest total normal force of the environment on one robot body \[N\].
     pub max_link_n: f64,
+    /// Hand frame origin in the world \[m\].
+    pub hand_position_m: [f64; 3],
+    /// Distance from the hand frame origin along `+z_h` to the first object or person (the
+    /// sensed geoms) \[m\]; infinite when nothing is ahead.
+    pub hand_distance_m: f64,
 }
 
 /// Measures contact forces for one hand frame (a URDF link of the scene's robot).
@@ -39,10 +45,11 @@ impl ContactProbe {
 
     /// The forces of the world's current contacts: every contact between a robot geom and the
     /// environment (objects, persons, floor) contributes its normal force (`mj_contactForce`).
-    pub fn measure(&mut self, world: &World) -> ContactForces {
+    pub fn measure(&mut self, world: &World) -> ProbeReadings {
         let (model, data) = (world.mj_model(), world.mj_data());
         let (group, geom_body) = (model.geom_group(), model.geom_bodyid());
-        let z_hand = world.frame_pose(self.hand_frame).rotation * Vector3::z();
+        let hand = world.frame_pose(self.hand_frame);
+        let z_hand = hand.rotation * Vector3::z();
         self.per_body.fill(0.0);
         let mut hand_n = 0.0;
         for (k, con) in data.contact().iter().enumerate() {
@@ -66,9 +73,18 @@ impl ContactProbe {
                 hand_n += (-on_robot.dot(&z_hand)).max(0.0);
             }
         }
-        ContactForces {
+        let origin = hand.translation.vector;
+        let (pnt, vec): ([f64; 3], [f64; 3]) = (origin.into(), z_hand.into());
+        let mut geom = [-1i32];
+        // SAFETY: model and data belong together; the arrays have mj_ray's sizes (3, 3, mjNGROUP, 1), no normal wanted.
+        let distance = unsafe {
+            mujoco_c::mj_ray(model.ffi(), data.ffi(), &pnt, &vec, SENSED_GROUPS.as_ptr(), true, -1, geom.as_mut_ptr(), std::ptr::null_mut())
+        };
+        ProbeReadings {
             hand_n,
             max_link_n: self.per_body.iter().copied().fold(0.0, f64::max),
+            hand_position_m: origin.into(),
+            hand_distance_m: if geom[0] >= 0 { distance } else { f64::INFINITY },
         }
     }
 }

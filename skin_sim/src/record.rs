@@ -35,6 +35,11 @@ pub struct CycleRecord {
     /// Largest total normal contact force of the environment on one robot link, from MuJoCo
     /// \[N\] (the physical counterpart of the skin's `‖F_c‖`).
     pub link_force_n: f64,
+    /// Hand frame origin in the world, from MuJoCo \[m\].
+    pub hand_position_m: [f64; 3],
+    /// Distance ahead of the palm (along `+z_h`) to the first object or person, from MuJoCo \[m\]
+    /// (infinite: nothing ahead).
+    pub hand_distance_m: f64,
     /// Force reference of the scene at this time \[N\] (NaN: none active).
     pub force_reference_n: f64,
     /// The hand signal reference `f_c,d` given to the controller (NaN: none).
@@ -80,6 +85,8 @@ pub struct RunRecord {
     pub eps_v_mps: f64,
     /// The supervisor's contact force limit `ε_c` \[N\] (paper 000 Table I).
     pub eps_c_n: f64,
+    /// `d_p,d` of the hand distance task \[m\] (paper 003 eq. (9), pre-contact).
+    pub hand_distance_desired_m: f64,
     /// One entry per control cycle, in time order.
     pub cycles: Vec<CycleRecord>,
     /// Arrangement switches in time order.

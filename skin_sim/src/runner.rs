@@ -105,6 +105,7 @@ fn limits_of(config: &ControllerConfig) -> Limits {
     Limits {
         eps_c_n: thresholds.contact_force_n,
         goal_tolerance_m: thresholds.goal_tolerance_m,
+        hand_distance_desired_m: config.tasks.hand_force.distance_desired_m,
     }
 }
 
@@ -195,6 +196,8 @@ impl ExternalRun {
             torque_norm: decision.torque_norm,
             hand_force_n: forces.hand_n,
             link_force_n: forces.max_link_n,
+            hand_position_m: forces.hand_position_m,
+            hand_distance_m: forces.hand_distance_m,
             force_reference_n,
             force_reference_signal,
             interaction: self.interactions.active(t_s, world.q()),

@@ -54,7 +54,7 @@ pub const SCENARIOS: [Scenario; 7] = [
     Scenario {
         name: "tactile_guidance",
         description: "paper 003 Exp. 2 (Fig. 6): proximity approach to a table, touches guide the hand, a person nears the base",
-        controller: "tomm_phases_table.yaml",
+        controller: "tomm_phases.yaml",
         force_targets: None,
     },
     Scenario {

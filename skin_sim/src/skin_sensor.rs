@@ -17,6 +17,11 @@
 //!   pressed (a corner or an edge of the geom between sample points), the cells within
 //!   `contact_radius_m` of the box spanned by the contact points share it, weighted by that
 //!   distance and by how squarely they face the force.
+//! - Touches: a scripted push on a robot link (the scene's user, `pushes:` with `link:`) is felt
+//!   like a contact by the cells where its line of action enters the link: the cells facing the
+//!   force within [`TOUCH_RADIUS_M`] of that line (on the side the force comes from) share it as
+//!   they share a contact (the user's hand is no MuJoCo geom; the push acts through
+//!   `xfrc_applied`).
 //! - Optional zero-mean Gaussian noise on every signal (seeded), then clamped to [0, 1].
 
 use std::ops::Range;
@@ -81,6 +86,20 @@ pub struct SkinSensor {
     weights: Vec<f64>,
     readings: Vec<CellReading>,
 }
+
+/// A scripted touch of the scene's user on a robot body, at the current state.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Touch {
+    /// MuJoCo body pressed.
+    pub body: usize,
+    /// A point on the force's line of action (world) \[m\].
+    pub point: Point3<f64>,
+    /// Force on the body (world) \[N\].
+    pub force: Vector3<f64>,
+}
+
+/// Radius of the user's hand: cells this close to a touch's line of action share its force \[m\].
+pub const TOUCH_RADIUS_M: f64 = 0.05;
 
 /// Smallest `-n_i · u` a loaded cell is credited with in the force balance of
 /// [`SkinSensor::distribute`]: a cell reads at most twice the contact force.
@@ -151,9 +170,12 @@ impl SkinSensor {
         (pose * c.position, pose * c.normal)
     }
 
-    /// Samples every active cell from the data's current kinematics and contacts.
-    pub(crate) fn sample<M: ModelType>(&mut self, data: &mut MjData<M>) {
+    /// Samples every active cell from the data's current kinematics, contacts and `touches`.
+    pub(crate) fn sample<M: ModelType>(&mut self, data: &mut MjData<M>, touches: impl Iterator<Item = Touch>) {
         self.contact_forces(data);
+        for t in touches {
+            self.distribute_touch(data, &t);
+        }
         for i in 0..self.cells.len() {
             if !self.cells[i].active {
                 continue;
@@ -246,12 +268,38 @@ impl SkinSensor {
             self.weights.clear();
             self.weights.extend(self.by_body[range.clone()].iter().map(|&i| weight(&cells[i])));
         }
+        self.share(range, local_f.norm(), |c| -u.dot(&c.normal));
+    }
+
+    /// A touch's force shared by the cells of its body near its line of action (see the module
+    /// doc), as [`Self::distribute`] shares a contact's.
+    fn distribute_touch<M: ModelType>(&mut self, data: &MjData<M>, touch: &Touch) {
+        let Some(range) = self.body_range.get(touch.body).cloned() else { return };
+        let pose = body_pose(data, touch.body);
+        let Some(u) = pose.inverse_transform_vector(&touch.force).try_normalize(0.0) else { return };
+        let point = pose.inverse_transform_point(&touch.point);
+        let weight = |c: &SimCell| {
+            let d = c.position - point;
+            let along = d.dot(&u);
+            let off_line = (d - u * along).norm();
+            // before the point along the force (where it comes from), facing it
+            if along > 0.0 { 0.0 } else { (1.0 - off_line / TOUCH_RADIUS_M).max(0.0) * (-u.dot(&c.normal)).max(0.0) }
+        };
+        self.weights.clear();
+        self.weights.extend(self.by_body[range.clone()].iter().map(|&i| weight(&self.cells[i])));
+        self.share(range, touch.force.norm(), |c| -u.dot(&c.normal));
+    }
+
+    /// Adds `magnitude` to the cells of `range` (by-body order) in proportion to `self.weights`,
+    /// with the cells' normal loads balancing it along its direction (`facing`: `-n_i · u`).
+    fn share(&mut self, range: Range<usize>, magnitude: f64, facing: impl Fn(&SimCell) -> f64) {
         // Nearly tangential cells count as MIN_FACING: the cover carries the rest in shear.
+        let cells = &self.cells;
         let balance: f64 = self.by_body[range.clone()].iter().zip(&self.weights).map(|(&i, w)| w * facing(&cells[i]).max(MIN_FACING)).sum();
         if balance <= 0.0 {
             return; // no skin there facing the force
         }
-        let scale = local_f.norm() / balance;
+        let scale = magnitude / balance;
         for (&i, w) in self.by_body[range].iter().zip(&self.weights) {
             self.force_n[i] += w * scale;
         }

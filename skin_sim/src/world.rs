@@ -14,8 +14,9 @@ use thiserror::Error;
 use crate::frames::{body_pose, FrameRef};
 use crate::lidar::Lidar;
 use crate::mjcf::{scene_xml, MjcfError};
+use crate::scene::spec::push_scale;
 use crate::scene::{Scene, SceneError};
-use crate::skin_sensor::SkinSensor;
+use crate::skin_sensor::{SkinSensor, Touch};
 
 /// Errors building or driving a [`World`].
 #[derive(Debug, Error)]
@@ -66,6 +67,24 @@ struct Push {
     force: Vector3<f64>,
     start_s: f64,
     end_s: f64,
+    ramp_s: f64,
+}
+
+impl Push {
+    /// The force acting at time `t` (world) \[N\].
+    fn force_at(&self, t: f64) -> Vector3<f64> {
+        self.force * push_scale(t, self.start_s, self.end_s, self.ramp_s)
+    }
+}
+
+/// The pushes acting now, as the skin feels them (pushes on objects touch no cell).
+fn touches(pushes: &[Push], data: &MjData<Box<MjModel>>) -> Vec<Touch> {
+    let t = data.time();
+    pushes
+        .iter()
+        .filter(|p| p.force_at(t) != Vector3::zeros())
+        .map(|p| Touch { body: p.body, point: body_pose(data, p.body) * p.point, force: p.force_at(t) })
+        .collect()
 }
 
 /// A MuJoCo world built from a scene. One [`World::step`] advances one `timestep_s`; the skin and
@@ -156,6 +175,7 @@ impl World {
                     force: Vector3::from(p.force_n),
                     start_s: p.start_s,
                     end_s: p.end_s,
+                    ramp_s: p.ramp_s,
                 }
             })
             .collect();
@@ -299,7 +319,8 @@ impl World {
     /// their rates).
     pub fn sample_sensors(&mut self) {
         if let Some(skin) = &mut self.skin {
-            skin.sample(&mut self.data);
+            let touches = touches(&self.pushes, &self.data);
+            skin.sample(&mut self.data, touches.into_iter());
         }
         if let Some(lidar) = &mut self.lidar {
             lidar.scan(&mut self.data);
@@ -323,16 +344,17 @@ impl World {
         }
         for k in 0..self.pushes.len() {
             let p = self.pushes[k];
-            if t < p.start_s || t >= p.end_s {
+            let force = p.force_at(t);
+            if force == Vector3::zeros() {
                 continue;
             }
             // xfrc_applied acts at the body's centre of mass: add the moment of the offset.
             let pose = body_pose(&self.data, p.body);
             let com = Vector3::from(self.data.xipos()[p.body]);
-            let torque = ((pose * p.point).coords - com).cross(&p.force);
+            let torque = ((pose * p.point).coords - com).cross(&force);
             let f = &mut self.data.xfrc_applied_mut()[p.body];
             for i in 0..3 {
-                f[i] += p.force[i];
+                f[i] += force[i];
                 f[3 + i] += torque[i];
             }
         }
@@ -359,7 +381,8 @@ impl World {
     fn sample_due_sensors(&mut self) {
         if let Some(skin) = &mut self.skin {
             if self.steps % self.skin_every == 0 {
-                skin.sample(&mut self.data);
+                let touches = touches(&self.pushes, &self.data);
+                skin.sample(&mut self.data, touches.into_iter());
             }
         }
         if let Some(lidar) = &mut self.lidar {

@@ -147,6 +147,21 @@ fn force_tracking_base_motion_meets_table_3_with_and_without_base_motion() {
 }
 
 #[test]
+fn tactile_guidance_passes_every_outcome_check() {
+    // Paper 003 Exp. 2, the whole scene (50 s): the hand approaches the board and holds d_p,d
+    // = 3 cm (MuJoCo's distance ahead of the palm), touches on the arm (felt by its skin) move
+    // it along the board, nothing of the robot presses on anything, a person nears the base.
+    let report = run("tactile_guidance", 50.0);
+    let names: Vec<&str> = report.checks.iter().map(|c| c.name).collect();
+    for wanted in ["no link presses", "hand keeps d_p,d", "touches on the arm guide the hand"] {
+        assert!(names.iter().any(|n| n.starts_with(wanted)), "{wanted}: checks {names:?}");
+    }
+    for c in &report.checks {
+        assert!(c.passed, "{}: {}", c.name, c.detail);
+    }
+}
+
+#[test]
 fn force_tracking_interaction_passes_every_outcome_check() {
     // Paper 003 Exp. 3, the whole scene (90 s): 5 +- 2 N while the arm is pushed and a person
     // nears the base; RMS force errors within Table 3's 0.23 N (without) and 0.58 N (with).

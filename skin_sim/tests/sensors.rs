@@ -75,6 +75,34 @@ fn a_link_pressed_into_a_fixed_box_gives_force_on_the_cells_near_the_contact_onl
 }
 
 #[test]
+fn a_touch_on_a_link_is_felt_by_the_cells_where_it_enters_and_ramps_with_the_push() {
+    // The user pushes link3 (x in [0.5, 0.75], radius 0.037) at its middle along -y: the cells
+    // on its +y side, around x = 0.625, feel it; the -y side and other links do not.
+    let push = "pushes:\n  - {link: link3, force_n: [0.0, -20.0, 0.0], point_m: [0.125, 0.0, 0.0], start_s: 0.1, end_s: 0.9, ramp_s: 0.2}\n";
+    let mut w = world(&planar7(push));
+    let entry = Point3::new(0.625, 0.037, 0.0);
+    let felt = |w: &World| -> Vec<(f64, f64)> {
+        let sensor = w.skin().unwrap();
+        (0..w.skin_readings().len())
+            .filter(|&i| w.skin_readings()[i].force[0] > 0.0)
+            .map(|i| ((sensor.cell_world(w.mj_data(), i).0 - entry).norm(), w.skin_readings()[i].force[0]))
+            .collect()
+    };
+    run(&mut w, 0.05);
+    assert!(felt(&w).is_empty(), "nothing before the push");
+    run(&mut w, 0.1); // 0.15 s: a quarter of the way up the ramp
+    let rising: f64 = felt(&w).iter().map(|c| c.1).sum();
+    run(&mut w, 0.25); // 0.4 s: full force
+    let full = felt(&w);
+    assert!(!full.is_empty(), "the touch is felt");
+    assert!(full.iter().all(|&(d, _)| d < 0.07), "only cells near where the force enters: {full:?}");
+    let total: f64 = full.iter().map(|c| c.1).sum();
+    assert!(rising > 0.0 && rising < total, "the ramp: {rising} then {total}");
+    run(&mut w, 0.6); // 1.0 s: after the window
+    assert!(felt(&w).is_empty(), "nothing after the push");
+}
+
+#[test]
 fn the_lidar_measures_a_box_in_the_base_frame_and_never_the_robot() {
     let lidar = "lidar: {rays: 360, range_m: 8.0}\n";
     for (yaw, box_xy) in [(0.0, [2.0, 0.0]), (std::f64::consts::FRAC_PI_2, [0.0, 2.0])] {

@@ -130,6 +130,8 @@ fn scene_errors_name_the_file_and_the_key() {
     assert!(e.contains("`control_rate_hz`") && e.contains("whole number"), "{e}");
     let e = invalid(&planar7("pushes: [{link: link3, object: b, force_n: [1, 0, 0], start_s: 0, end_s: 1}]\n"));
     assert!(e.contains("`pushes[0]`"), "{e}");
+    let e = invalid(&planar7("pushes: [{link: link3, force_n: [1, 0, 0], start_s: 0, end_s: 1, ramp_s: 0.6}]\n"));
+    assert!(e.contains("`pushes[0].ramp_s`"), "{e}");
     let circle = "{start_s: 1, end_s: 19, circle: {radius_m: 0.2, period_s: 5}}";
     let e = invalid(&planar7(&format!("base_motions: [{circle}]\n")));
     assert!(e.contains("`base_motions`") && e.contains("does not move"), "{e}");

@@ -170,8 +170,11 @@ impl TaskSet {
             _ => None,
         };
         let q_post = if config.setup.posture.is_empty() { vec![0.0; nv] } else { config.setup.posture.clone() };
-        let posture = Posture::new(nv, &p.posture, &q_post)
+        let mut posture = Posture::new(nv, &p.posture, &q_post)
             .map_err(|error| SetupError::Task { file: config.source.clone(), error })?;
+        if let ([Some(x), Some(y), Some(yaw)], Some(gains)) = (base_joints, p.posture.base) {
+            posture.set_base_gains([x, y, yaw], gains).map_err(|error| SetupError::Task { file: config.source.clone(), error })?;
+        }
         let zero = Vector3::zeros();
         Ok(TaskSet {
             kinds,

@@ -122,15 +122,25 @@ fn setup_errors_name_file_and_key() {
 #[test]
 fn a_derived_setup_is_its_base_with_its_keys_replaced() {
     let (phases, _) = ControllerSetup::load(&setup("tomm_phases")).unwrap();
-    let (table, _) = ControllerSetup::load(&setup("tomm_phases_table")).unwrap();
     let (tomm, _) = ControllerSetup::load(&setup("tomm")).unwrap();
-    // what tomm_phases_table.yaml sets differs; everything else comes through two bases
+    // a file two bases down (in another directory: the bases' relative paths must follow)
+    let dir = std::env::temp_dir().join(format!("skin_core_setup_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let derived = dir.join("derived.yaml");
+    let posture: Vec<String> = (0..15).map(|j| format!("{}", 0.01 * j as f64)).collect();
+    let text = format!("base: {}\nposture: [{}]\n", setup("tomm_phases").display(), posture.join(", "));
+    std::fs::write(&derived, text).unwrap();
+    let (table, _) = ControllerSetup::load(&derived).unwrap();
+    // what the derived file sets differs; everything else comes through two bases (the file
+    // paths rebased to the derived file's directory)
     assert_ne!(table.posture, phases.posture);
-    assert_eq!(ControllerSetup { posture: phases.posture.clone(), ..table }, phases);
+    let rebased = ControllerSetup { urdf: table.urdf.clone(), skin_layout: table.skin_layout.clone(), skin_model: table.skin_model.clone(), tasks: table.tasks.clone(), supervisor: table.supervisor.clone(), resolver: table.resolver.clone(), ..phases.clone() };
+    assert_eq!(ControllerSetup { posture: phases.posture.clone(), ..table.clone() }, rebased);
     assert_eq!(phases.policy, Some(crate::supervisor::Policy::Phases));
     let resolver = tomm.resolver.clone();
     assert_eq!(ControllerSetup { posture: tomm.posture.clone(), policy: None, hierarchy_dynamics: tomm.hierarchy_dynamics, resolver, ..phases }, tomm);
-    Controller::from_setup_file(&setup("tomm_phases_table"), 0.0).expect("the base's relative paths resolve");
+    Controller::from_setup_file(&derived, 0.0).expect("the bases' relative paths resolve");
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

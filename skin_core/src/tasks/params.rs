@@ -105,17 +105,23 @@ pub struct PostureParams {
     pub d_c: Vec<f64>,
     /// Gain on the body skin torque `τ_skin` (eq. 14) inside `τ_s` \[N per signal unit\].
     pub skin_gain: f64,
-    /// `K_c`, `D_c` of the base joints while they track a commanded base motion
-    /// ([`super::posture::BaseReference`]); none: the base joints' `k_c`, `d_c`.
+    /// `K_c`, `D_c` of the base joints (x, y, yaw) at rest, replacing `k_c`, `d_c` there (none:
+    /// `k_c`, `d_c`): the base's virtual mass is far larger than an arm joint's inertia, so the
+    /// arm's damping leaves it ringing after a touch.
     #[serde(default)]
-    pub base_tracking: Option<BaseTrackingGains>,
+    pub base: Option<BaseGains>,
+    /// `K_c`, `D_c` of the base joints while they track a commanded base motion
+    /// ([`super::posture::BaseReference`]); none: the base joints' gains at rest.
+    #[serde(default)]
+    pub base_tracking: Option<BaseGains>,
 }
 
-/// Gains of the base joints (world x, y, yaw) toward a commanded base motion: stiffer than the
-/// posture's, so that the lowest level follows the motion against the arm's own posture pull.
+/// Gains of the base joints (world x, y, yaw) in the posture torque of eq. (18): at rest, or
+/// toward a commanded base motion (stiffer than the posture's, so that the lowest level follows
+/// the motion against the arm's own posture pull).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct BaseTrackingGains {
+pub struct BaseGains {
     /// Stiffness along x, y \[N/m\] and about yaw \[N m/rad\].
     pub k_c: [f64; 3],
     /// Damping along x, y \[N s/m\] and about yaw \[N m s/rad\].
@@ -215,10 +221,12 @@ impl TaskParams {
                 nonneg("posture.", &format!("{name}[{i}]"), *x)?;
             }
         }
-        if let Some(b) = &p.base_tracking {
-            for (name, v) in [("k_c", b.k_c), ("d_c", b.d_c)] {
-                for (i, x) in v.iter().enumerate() {
-                    nonneg("posture.base_tracking.", &format!("{name}[{i}]"), *x)?;
+        for (prefix, gains) in [("posture.base.", &p.base), ("posture.base_tracking.", &p.base_tracking)] {
+            if let Some(b) = gains {
+                for (name, v) in [("k_c", b.k_c), ("d_c", b.d_c)] {
+                    for (i, x) in v.iter().enumerate() {
+                        nonneg(prefix, &format!("{name}[{i}]"), *x)?;
+                    }
                 }
             }
         }

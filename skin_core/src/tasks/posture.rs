@@ -11,7 +11,7 @@
 
 use nalgebra::DVector;
 
-use super::params::{BaseTrackingGains, PostureParams};
+use super::params::{BaseGains, PostureParams};
 use super::TaskError;
 use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::PatchWrench;
@@ -54,7 +54,7 @@ pub struct Posture {
     /// Desired posture `q_post`.
     pub q_post: DVector<f64>,
     /// Gains of the base joints while a [`BaseReference`] is set (none: `k_c`, `d_c`).
-    pub base_tracking: Option<BaseTrackingGains>,
+    pub base_tracking: Option<BaseGains>,
     base: Option<BaseTarget>,
     tau_skin: DVector<f64>,
     tau: DVector<f64>,
@@ -81,6 +81,20 @@ impl Posture {
             tau_skin: DVector::zeros(nv),
             tau: DVector::zeros(nv),
         })
+    }
+
+    /// Gives the base joints `joints` (model indices of x, y, yaw) their own gains at rest
+    /// (`posture.base`); an index out of range is refused.
+    pub fn set_base_gains(&mut self, joints: [usize; 3], gains: BaseGains) -> Result<(), TaskError> {
+        let nv = self.tau.len();
+        if let Some(&j) = joints.iter().find(|&&j| j >= nv) {
+            return Err(TaskError::Length { what: "base joint index", expected: nv, got: j });
+        }
+        for (k, &j) in joints.iter().enumerate() {
+            self.k_c[j] = gains.k_c[k];
+            self.d_c[j] = gains.d_c[k];
+        }
+        Ok(())
     }
 
     /// Sets the commanded base motion of the base joints `joints` (model indices of x, y, yaw),

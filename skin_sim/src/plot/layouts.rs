@@ -144,3 +144,46 @@ pub fn paper003_figure(title: &str, s: &Paper003Signals) -> Figure {
     }
     fig
 }
+
+/// Signals of paper 003's Exp. 2 (pre-contact approach and tactile guidance), laid out like its
+/// Fig. 6; one sample per control cycle, every slice as long as `t`.
+#[derive(Debug, Clone, Copy)]
+pub struct GuidanceSignals<'a> {
+    /// Time \[s\].
+    pub t: &'a [f64],
+    /// Distance `d_p` of the hand to the surface ahead of the palm \[m\] (NaN: nothing ahead).
+    pub distance: &'a [f64],
+    /// `d_p,d` \[m\].
+    pub distance_desired: &'a [f64],
+    /// Hand position in the world, x, y, z \[m\].
+    pub hand: [&'a [f64]; 3],
+    /// Base position in the world, x, y \[m\].
+    pub base: [&'a [f64]; 2],
+    /// Scripted interaction periods `(start, end)` \[s\]: touches on the arm, a person near the
+    /// base.
+    pub interaction: &'a [(f64, f64)],
+}
+
+/// Paper 003 Fig. 6: (a) the hand's distance to the surface against `d_p,d`, (b) the hand's
+/// position (guided along the surface by the touches), (c) the base's position (moved by base
+/// collision avoidance); interaction periods shaded. (The paper's wrist moments are not drawn.)
+pub fn guidance_figure(title: &str, s: &GuidanceSignals) -> Figure {
+    let t = s.t;
+    let mut fig = Figure::new(title)
+        .panel(
+            Panel::lines("(a) Hand distance to the surface", "d_p [m]")
+                .line("measured", t, s.distance)
+                .line("desired", t, s.distance_desired),
+        )
+        .panel(
+            Panel::lines("(b) Hand position", "w_x_h [m]")
+                .line("x", t, s.hand[0])
+                .line("y", t, s.hand[1])
+                .line("z", t, s.hand[2]),
+        )
+        .panel(Panel::lines("(c) Base position", "w_x_b [m]").line("x", t, s.base[0]).line("y", t, s.base[1]));
+    for &(a, b) in s.interaction {
+        fig = fig.shade(a, b, "interaction (touch, person)", Tint::Red);
+    }
+    fig
+}

@@ -25,7 +25,7 @@ use thiserror::Error;
 
 // The study's charts (`crate::study::charts`) draw with the same font and colours.
 pub(crate) use draw::{font, FONT, PALETTE};
-pub use layouts::{paper000_figure, paper003_figure, Paper000Signals, Paper003Signals};
+pub use layouts::{guidance_figure, paper000_figure, paper003_figure, GuidanceSignals, Paper000Signals, Paper003Signals};
 
 /// Errors building or writing a figure; each names the output file.
 #[derive(Debug, Error)]

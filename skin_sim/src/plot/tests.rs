@@ -151,6 +151,20 @@ fn paper003_layout_reports_the_contact_rms_error() {
 }
 
 #[test]
+fn the_guidance_figure_has_paper_003_fig_6_panels() {
+    let t: Vec<f64> = (0..200).map(|k| k as f64 * 0.05).collect();
+    let d: Vec<f64> = t.iter().map(|t| 0.03 + 0.02 * (-t).exp()).collect();
+    let x: Vec<f64> = t.iter().map(|t| 0.8 + 0.01 * t).collect();
+    let fig = guidance_figure(
+        "synthetic guidance",
+        &GuidanceSignals { t: &t, distance: &d, distance_desired: &[0.03; 200], hand: [&x, &x, &x], base: [&x, &x], interaction: &[(2.0, 4.0)] },
+    );
+    let titles: Vec<&str> = fig.panels.iter().map(|p| p.title.as_str()).collect();
+    assert_eq!(titles, ["(a) Hand distance to the surface", "(b) Hand position", "(c) Base position"]);
+    assert!(fig.render_rgb().unwrap().iter().any(|&c| c != 255));
+}
+
+#[test]
 fn mismatched_lengths_name_file_panel_and_series() {
     let fig =
         Figure::new("bad").panel(Panel::lines("speed", "[m/s]").line("v", &[0.0, 1.0], &[0.0]));

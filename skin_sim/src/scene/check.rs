@@ -115,9 +115,7 @@ fn check_base_motion(key: &str, m: &BaseMotionSpec) -> Checked {
         return Err(reject(format!("{key}.end_s"), format!("{} must be after start_s", m.end_s)));
     }
     positive(format!("{key}.ramp_s"), m.ramp_s)?;
-    if 2.0 * m.ramp_s > m.end_s - m.start_s {
-        return Err(reject(format!("{key}.ramp_s"), format!("{} s: fade-in and fade-out must fit in the window", m.ramp_s)));
-    }
+    ramp_fits(key, m.ramp_s, m.start_s, m.end_s)?;
     match (&m.circle, &m.swing) {
         (Some(c), None) => {
             positive(format!("{key}.circle.radius_m"), c.radius_m)?;
@@ -231,6 +229,14 @@ fn check_person(key: &str, p: &PersonSpec) -> Checked {
     Ok(())
 }
 
+/// The rise and the fall of a window's `ramp_s` fit in `[start_s, end_s]`.
+fn ramp_fits(key: &str, ramp_s: f64, start_s: f64, end_s: f64) -> Checked {
+    if 2.0 * ramp_s > end_s - start_s {
+        return Err(reject(format!("{key}.ramp_s"), format!("{ramp_s} s: the rise and the fall must fit in the window (at most half of it)")));
+    }
+    Ok(())
+}
+
 fn check_push(key: &str, p: &PushSpec, objects: &[ObjectSpec]) -> Checked {
     finite(format!("{key}.force_n"), &p.force_n)?;
     finite(format!("{key}.point_m"), &p.point_m)?;
@@ -238,6 +244,8 @@ fn check_push(key: &str, p: &PushSpec, objects: &[ObjectSpec]) -> Checked {
     if !(p.end_s.is_finite() && p.end_s > p.start_s) {
         return Err(reject(format!("{key}.end_s"), format!("{} must be after start_s", p.end_s)));
     }
+    non_negative(format!("{key}.ramp_s"), p.ramp_s)?;
+    ramp_fits(key, p.ramp_s, p.start_s, p.end_s)?;
     match (&p.object, &p.link) {
         (Some(o), None) => {
             if !objects.iter().any(|x| &x.name == o) {

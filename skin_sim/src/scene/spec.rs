@@ -256,6 +256,22 @@ pub struct PushSpec {
     pub start_s: f64,
     /// End of the window \[s\].
     pub end_s: f64,
+    /// Rise and fall time of the force \[s\] (a hand's touch builds up and lets go: the force
+    /// ramps linearly from 0 over the window's first and last `ramp_s`); 0: a step.
+    #[serde(default)]
+    pub ramp_s: f64,
+}
+
+/// The fraction of a push's force acting at time `t`: 0 outside `[start_s, end_s)`, ramping
+/// linearly over the window's first and last `ramp_s` (see [`PushSpec::ramp_s`]).
+pub fn push_scale(t: f64, start_s: f64, end_s: f64, ramp_s: f64) -> f64 {
+    if t < start_s || t >= end_s {
+        0.0
+    } else if ramp_s > 0.0 {
+        ((t - start_s) / ramp_s).min((end_s - t) / ramp_s).min(1.0)
+    } else {
+        1.0
+    }
 }
 
 /// A person-sized vertical capsule standing on the floor, moved along a path (a mocap body: it

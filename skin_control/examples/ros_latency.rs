@@ -14,6 +14,7 @@ use r2r::nav_msgs::msg::Odometry;
 use r2r::sensor_msgs::msg::{JointState, LaserScan};
 use r2r::skin_msgs::msg::{SkinCell, SkinCellArray};
 use r2r::std_msgs::msg::Float64MultiArray;
+use r2r::NativeMsg;
 use skin_control::qos;
 use skin_core::controller::ControllerConfig;
 
@@ -59,7 +60,7 @@ fn main() -> Result<()> {
     let mut odom = Odometry::default();
     odom.pose.pose.orientation.w = 1.0;
     let mut scan = LaserScan { header: r2r::std_msgs::msg::Header { frame_id: "laser".into(), ..Default::default() }, angle_min: -std::f32::consts::PI, angle_max: std::f32::consts::PI, angle_increment: std::f32::consts::TAU / 360.0, range_min: 0.05, range_max: 8.0, ranges: vec![8.5; 360], ..Default::default() };
-    let mut cells = SkinCellArray {
+    let cells = SkinCellArray {
         cells: config
             .layout
             .cells()
@@ -69,6 +70,11 @@ fn main() -> Result<()> {
             .collect(),
         ..Default::default()
     };
+
+    // The skin driver keeps its message in the middleware's (C) form and updates it in place
+    // each period, as a C++ driver would: r2r's `publish` of the Rust message would first copy
+    // 700 cells into a new C message (an allocation per cell).
+    let mut cells = NativeMsg::<SkinCellArray>::from(&cells);
 
     // wait until the controller listens to every input
     let start = Instant::now();
@@ -88,12 +94,12 @@ fn main() -> Result<()> {
         joints.header.stamp = stamp.clone();
         odom.header.stamp = stamp.clone();
         scan.header.stamp = stamp.clone();
-        cells.header.stamp = stamp;
+        (cells.header.stamp.sec, cells.header.stamp.nanosec) = (stamp.sec, stamp.nanosec);
         joints_pub.publish(&joints)?;
         odom_pub.publish(&odom)?;
         scan_pub.publish(&scan)?;
         let sent = Instant::now();
-        cells_pub.publish(&cells)?;
+        cells_pub.publish_native(&mut cells)?;
         loop {
             // rcl_wait returns as soon as the command arrives: a longer timeout only spares the
             // controller the probe's polling (both share the machine's cores)

@@ -14,6 +14,7 @@
 //!   display this message type: `/skin/markers` draws the wrenches in the link frames.
 use std::fmt::{self, Write as _};
 
+pub mod cdr_cells;
 pub mod control;
 pub mod robot;
 

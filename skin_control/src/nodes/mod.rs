@@ -18,6 +18,8 @@ pub mod task_controller;
 pub mod topics {
     /// Skin cells (skin_msgs/SkinCellArray).
     pub const CELLS: &str = "/skin/cells";
+    /// The type of [`CELLS`], for raw subscriptions.
+    pub const CELLS_TYPE: &str = "skin_msgs/msg/SkinCellArray";
     /// Patch wrenches (skin_msgs/PatchWrenchArray).
     pub const PATCHES: &str = "/skin/patches";
     /// Joint states (sensor_msgs/JointState).

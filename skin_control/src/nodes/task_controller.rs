@@ -12,7 +12,7 @@ use futures::{Stream, StreamExt};
 use r2r::geometry_msgs::msg::{PoseStamped, Twist};
 use r2r::nav_msgs::msg::Odometry;
 use r2r::sensor_msgs::msg::{JointState, LaserScan};
-use r2r::skin_msgs::msg::{Arrangement, ControllerState, SkinCellArray};
+use r2r::skin_msgs::msg::{Arrangement, ControllerState};
 use r2r::std_msgs::msg::{Float64, Float64MultiArray};
 use r2r::{ParameterValue, RosParams};
 use skin_core::controller::ControllerConfig;
@@ -258,11 +258,12 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
             s.refused(result);
         })?;
     }
-    let cells = node.subscribe_native::<SkinCellArray>(CELLS, qos::every_sample())?;
+    // Read from the serialized bytes (convert::cdr_cells: the largest input, on the latency path).
+    let cells = node.subscribe_raw(CELLS, CELLS_TYPE, qos::every_sample())?;
     spawn_sub(spawner, cells, &shared, |s, msg| {
         let now = s.now();
         let Shared { tc, logger, .. } = &mut *s;
-        let result = tc.on_cells(&msg, now, |i| {
+        let result = tc.on_cells_cdr(&msg, now, |i| {
             r2r::log_warn!(logger, "{CELLS}: {i} (further ones are counted in /controller/state)");
         });
         s.refused(result);

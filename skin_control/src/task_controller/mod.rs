@@ -26,6 +26,7 @@ use crate::convert::control::{
     imposed_of, split_arms, twist_msg, write_arm_command, write_controller_state, ArmCommand,
 };
 use crate::convert::robot::{goal_pose, time_s, JointIssue, JointStateIssue, ScanConverter, StateBuffer};
+use crate::convert::cdr_cells::CdrCells;
 use crate::convert::{update_cells, CellBuffer, CellMessage, Issue, IssueKind};
 use crate::input_health::{IssueTable, StampGate, StampIssue};
 use crate::nodes::topics::{ARRANGEMENT, CELLS, FORCE_REFERENCE, GOAL, JOINT_STATES, ODOM, SCAN};
@@ -214,7 +215,7 @@ struct Health {
     /// Per timed input: its gate and its first [`StampIssue`] counter.
     stamps: [(StampGate, usize); 4],
     /// The `message refused` counter of each topic that refuses whole messages.
-    refused: [(&'static str, usize); 5],
+    refused: [(&'static str, usize); 6],
     idle_periods: u64,
 }
 
@@ -224,7 +225,7 @@ impl Health {
         let joint_kinds = table.register(JOINT_STATES, JointIssue::ALL.map(JointIssue::name));
         let cell_kinds = table.register(CELLS, IssueKind::ALL.map(IssueKind::name));
         let stamps = TIMED_TOPICS.map(|t| (StampGate::default(), table.register(t, StampIssue::ALL.map(StampIssue::name))));
-        let refused = [ODOM, SCAN, GOAL, FORCE_REFERENCE, ARRANGEMENT].map(|t| (t, table.register(t, [REFUSED])));
+        let refused = [CELLS, ODOM, SCAN, GOAL, FORCE_REFERENCE, ARRANGEMENT].map(|t| (t, table.register(t, [REFUSED])));
         Health { table, joint_kinds, cell_kinds, stamps, refused, idle_periods: 0 }
     }
 
@@ -262,6 +263,8 @@ pub struct TaskController {
     needs_odom: bool,
     needs_cells: bool,
     cells_stamp: Option<Time>,
+    /// The buffer of [`Self::on_cells_cdr`].
+    cdr_cells: CdrCells,
     scan_stamp: Option<Time>,
     last_cycle: Option<Time>,
     arm_msgs: Vec<Float64MultiArray>,
@@ -289,6 +292,7 @@ impl TaskController {
             needs_odom: state.base().is_some(),
             needs_cells: cfg.layout.num_cells() > 0,
             cells: CellBuffer::new(&cfg.layout),
+            cdr_cells: CdrCells::default(),
             arm_msgs: arms.iter().map(|a| {
                 let mut m = Float64MultiArray::default();
                 write_arm_command(a, &[], &mut m);
@@ -393,6 +397,18 @@ impl TaskController {
         });
         self.cells_stamp = Some(stamp);
         Ok(())
+    }
+
+    /// `/skin/cells` as serialized bytes (`Node::subscribe_raw`: [`CdrCells`]), else as
+    /// [`Self::on_cells`]; bytes that are no `SkinCellArray` are refused.
+    pub fn on_cells_cdr(&mut self, data: &[u8], now_s: f64, report: impl FnMut(&Issue)) -> Result<(), InputError> {
+        let mut cdr = std::mem::take(&mut self.cdr_cells);
+        let result = match cdr.parse(data) {
+            Ok(()) => self.on_cells(&cdr, now_s, report),
+            Err(e) => Err(self.health.refuse(CELLS)(e)),
+        };
+        self.cdr_cells = cdr;
+        result
     }
 
     /// `/scan` at node time `now_s`.

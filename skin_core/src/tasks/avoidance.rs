@@ -10,8 +10,6 @@
 //! `activation_band_m` of the range (`docs/tasks.md`): a cell entering the range changes neither
 //! the torque (`F_di = 0` there) nor the projector of the lower levels by a step.
 
-use nalgebra::Matrix6xX;
-
 use super::params::AvoidanceParams;
 use super::point_rows::{push_inward_cell_row, row_activation};
 use super::TaskError;
@@ -28,7 +26,8 @@ use crate::skin::live::LiveCells;
 pub struct ProximityAvoidance {
     /// `K` and the nominal `d_range`.
     pub params: AvoidanceParams,
-    jac: Matrix6xX<f64>,
+    /// Scratch: one cell's Jacobian row.
+    row: Vec<f64>,
 }
 
 /// Summary of one avoidance update, for the supervisor.
@@ -47,7 +46,7 @@ pub struct AvoidanceSummary {
 impl ProximityAvoidance {
     /// The task for a model with `nv` joints; its level needs `layout.num_cells()` rows.
     pub fn new(nv: usize, params: AvoidanceParams) -> Self {
-        Self { params, jac: Matrix6xX::zeros(nv) }
+        Self { params, row: vec![0.0; nv] }
     }
 
     /// Fills `level` (force rows) from the non-silent cells of this cycle's readings with the
@@ -64,9 +63,9 @@ impl ProximityAvoidance {
         level: &mut TaskLevel,
     ) -> Result<AvoidanceSummary, TaskError> {
         level.clear();
-        let jac = &mut self.jac;
+        let row = &mut self.row;
         self.params.cells_in_range(layout, cells, proximity, range_m, |cell, fa| {
-            push_inward_cell_row(model, data, cell, fa, jac, level)
+            push_inward_cell_row(model, data, cell, fa, row, level)
         })
     }
 

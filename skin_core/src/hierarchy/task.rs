@@ -246,7 +246,9 @@ impl TaskLevel {
     }
 
     /// Checks that `k` rows of this reference fit; sets the kind on the first push; returns the
-    /// first new row.
+    /// first new row. Inlined: with the row count known at the call (one skin row each push,
+    /// many per cycle) the checks and copies below reduce to single stores, not library calls.
+    #[inline(always)]
     fn begin_rows(&mut self, k: usize, reference: &Reference<'_>) -> Result<usize, HierarchyError> {
         let (kind, lens) = match reference {
             Reference::Acceleration { xdd_star, jdot_qdot } => (ReferenceKind::Acceleration, [xdd_star.len(), jdot_qdot.len()]),
@@ -269,6 +271,7 @@ impl TaskLevel {
         Ok(self.rows)
     }
 
+    #[inline(always)]
     fn store_reference(&mut self, r0: usize, k: usize, reference: &Reference<'_>) {
         self.activation[r0..r0 + k].fill(1.0);
         match reference {

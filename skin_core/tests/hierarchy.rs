@@ -588,7 +588,7 @@ fn activated_case(s: &State, a: [f64; 2]) -> (DVector<f64>, DMatrix<f64>) {
     let mut skin = TaskLevel::new("avoidance", n, 2);
     for ((link, f), a) in [("link3", 4.0), ("link5", 2.0)].into_iter().zip(a) {
         let (jc, _) = s.point(link, [0.1, 0.02, 0.0]);
-        skin.push_directional_activated(&[0.0, 1.0, 0.0], &jc.rows(0, 3), f, a).unwrap();
+        skin.push_row_activated(jc.row(1).transpose().as_slice(), f, a).unwrap(); // direction +y
     }
     let (j1, jd1) = s.task("ee", [0.0; 3], &XY);
     let goal = acc_level("goal", &j1, &jd1, &[0.5, -0.3]);
@@ -618,7 +618,7 @@ fn hierarchy_activated_rows_are_exact_at_the_ends_and_continuous_between() {
         let mut skin = TaskLevel::new("avoidance", n, 2);
         for ((link, f), a) in [("link3", 4.0), ("link5", 2.0)].into_iter().zip(a) {
             let (jc, _) = s.point(link, [0.1, 0.02, 0.0]);
-            skin.push_directional_activated(&[0.0, 1.0, 0.0], &jc.rows(0, 3), f, a).unwrap();
+            skin.push_row_activated(jc.row(1).transpose().as_slice(), f, a).unwrap(); // direction +y
         }
         let mut solver = HierarchySolver::new(n, 1, 2, InverseParams::default()).unwrap();
         let mut tau = DVector::zeros(n);

@@ -346,7 +346,7 @@ fn tasks_do_not_allocate_after_setup() {
     ];
     let mut wrenches: Vec<PatchWrench> = Vec::with_capacity(layout.patches().len());
     let mut poses = Vec::with_capacity(layout.patches().len());
-    let mut live = LiveCells::with_capacity(n);
+    let mut live = LiveCells::with_capacity(n, &skin.proximity);
     let goal_x = Vector3::new(0.5, -0.3, 1.0);
     let goal_r = UnitQuaternion::identity();
 
@@ -360,7 +360,7 @@ fn tasks_do_not_allocate_after_setup() {
         let [l0, l1, l2, l3, l4, l5, l6, l7] = &mut levels;
         goal.update(&model, data, &goal_x, l0).unwrap();
         orient.update(&model, data, &goal_r, l1).unwrap();
-        avoid.update(&model, data, &layout, &live, &skin.proximity, 0.08, l2).unwrap();
+        avoid.update(&model, data, &layout, &live, 0.08, l2).unwrap();
         contact.update(&model, data, &layout, &live, &skin.force, &skin.fusion, l3).unwrap();
         hand_task.update(&model, data, HandMeasurement::Force { fused_signal: 0.1 }, &skin.proximity, l4).unwrap();
         wrist.update(&model, data, &gamma, l5).unwrap();

@@ -128,7 +128,7 @@ impl Controller {
             locked,
             goal: None,
             fusion: config.skin.fusion,
-            live: LiveCells::with_capacity(config.layout.num_cells()),
+            live: LiveCells::with_capacity(config.layout.num_cells(), &config.skin.proximity),
             wrenches: Vec::with_capacity(config.layout.patches().len()),
             patch_poses: Vec::with_capacity(config.layout.patches().len()),
             ee_jacobian: Matrix6xX::zeros(nv),
@@ -408,7 +408,7 @@ impl Controller {
         let (model, data, config) = (&self.config.model, &self.data, &self.config);
         let (skin, layout) = (&config.skin, &config.layout);
         let nominal = config.supervisor.sensing_range.nominal_m;
-        let avoid = self.tasks.avoidance.summarize(layout, &self.live, &skin.proximity, nominal).map_err(stage("avoidance"))?;
+        let avoid = self.tasks.avoidance.summarize(layout, &self.live, nominal).map_err(stage("avoidance"))?;
         let contact = self.tasks.contact.summarize(layout, &self.live, &skin.force, &skin.fusion).map_err(stage("contact reaction"))?;
         point_jacobian(model, data, self.ee, &nalgebra::Vector3::zeros(), &mut self.ee_jacobian)
             .map_err(stage("end-effector Jacobian"))?;

@@ -207,7 +207,7 @@ impl TaskSet {
         match self.kinds[index] {
             TaskKind::Avoidance => {
                 let layout = &cx.config.layout;
-                self.avoidance.update(model, data, layout, cx.cells, &skin.proximity, cx.sensing_range_m, level)?;
+                self.avoidance.update(model, data, layout, cx.cells, cx.sensing_range_m, level)?;
             }
             TaskKind::ContactReaction => {
                 let layout = &cx.config.layout;

@@ -28,27 +28,6 @@
 //! assert!(((&j * qdd)[0] - 0.1).abs() < 1e-12);
 //! ```
 
-/// Defines `pub(crate) fn $name` calling `$kernel` compiled for AVX2 when the CPU has it (4
-/// doubles per instruction instead of SSE2's 2; the same operations in the same order, so the
-/// same results: Rust never fuses a multiply and an add by itself), else as compiled.
-macro_rules! avx2_dispatch {
-    ($(#[$doc:meta])* $name:ident => $kernel:ident($($arg:ident: $ty:ty),*) $(-> $ret:ty)?) => {
-        $(#[$doc])*
-        pub(crate) fn $name($($arg: $ty),*) $(-> $ret)? {
-            #[cfg(target_arch = "x86_64")]
-            if std::arch::is_x86_feature_detected!("avx2") {
-                #[target_feature(enable = "avx2")]
-                unsafe fn avx2($($arg: $ty),*) $(-> $ret)? {
-                    $kernel($($arg),*)
-                }
-                // SAFETY: the CPU supports AVX2 (checked above).
-                return unsafe { avx2($($arg),*) };
-            }
-            $kernel($($arg),*)
-        }
-    };
-}
-
 mod dense;
 mod error;
 mod inverse;

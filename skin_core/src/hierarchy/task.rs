@@ -41,7 +41,7 @@ pub enum ReferenceKind {
 /// [`ReferenceKind`], set by the first push after a clear.
 ///
 /// A force level may instead be filled with *activated* rows
-/// ([`TaskLevel::push_directional_activated`]): each row carries an activation `a_i ∈ [0, 1]`
+/// ([`TaskLevel::push_row_activated`]): each row carries an activation `a_i ∈ [0, 1]`
 /// that weights its share of the null-space projector (continuous null-space projection after
 /// Dietrich et al. 2012, `docs/hierarchy.md`), so a skin row entering or leaving the sensing
 /// range fades in and out of the projector instead of switching it.
@@ -172,27 +172,28 @@ impl TaskLevel {
         Ok(())
     }
 
-    /// [`TaskLevel::push_directional`] for a force row `f` with activation `a ∈ [0, 1]`: the row's
-    /// torque is `N_{k−1} J_iᵀ f` as always, but it takes only the fraction `a` of its direction
-    /// out of the null space left to lower levels (`a = 0`: as if the row were absent, `a = 1`:
-    /// strict priority). Plain force rows in the same level count as `a = 1`.
-    pub fn push_directional_activated<R: Dim, C: Dim, S: Storage<f64, R, C>>(
-        &mut self,
-        direction: &[f64],
-        jacobian: &Matrix<f64, R, C, S>,
-        f: f64,
-        a: f64,
-    ) -> Result<(), HierarchyError> {
+    /// Appends the Jacobian row `row` (length nv, e.g. a skin cell's `dᵀ J_v` from
+    /// [`crate::model::point_jacobian_along`]) as a force row `f` with activation `a ∈ [0, 1]`:
+    /// the row's torque is `N_{k−1} J_iᵀ f` as always, but it takes only the fraction `a` of its
+    /// direction out of the null space left to lower levels (`a = 0`: as if the row were absent,
+    /// `a = 1`: strict priority). Plain force rows in the same level count as `a = 1`.
+    pub fn push_row_activated(&mut self, row: &[f64], f: f64, a: f64) -> Result<(), HierarchyError> {
         if !(0.0..=1.0).contains(&a) {
             return Err(self.input_error(format!("activation {a} is not in [0, 1]")));
         }
-        self.push_directional(direction, jacobian, Reference::Force { f: &[f] })?;
+        if row.len() != self.nv {
+            return Err(self.input_error(format!("row of length {}, expected {}", row.len(), self.nv)));
+        }
+        let reference = Reference::Force { f: &[f] };
+        let r0 = self.begin_rows(1, &reference)?;
+        self.jt[r0 * self.nv..(r0 + 1) * self.nv].copy_from_slice(row);
+        self.store_reference(r0, 1, &reference);
         self.activated = true;
-        self.activation[self.rows - 1] = a;
+        self.activation[r0] = a;
         Ok(())
     }
 
-    /// Whether the rows carry activations ([`TaskLevel::push_directional_activated`]).
+    /// Whether the rows carry activations ([`TaskLevel::push_row_activated`]).
     pub fn is_activated(&self) -> bool {
         self.activated
     }
@@ -245,7 +246,9 @@ impl TaskLevel {
     }
 
     /// Checks that `k` rows of this reference fit; sets the kind on the first push; returns the
-    /// first new row.
+    /// first new row. Inlined: with the row count known at the call (one skin row each push,
+    /// many per cycle) the checks and copies below reduce to single stores, not library calls.
+    #[inline(always)]
     fn begin_rows(&mut self, k: usize, reference: &Reference<'_>) -> Result<usize, HierarchyError> {
         let (kind, lens) = match reference {
             Reference::Acceleration { xdd_star, jdot_qdot } => (ReferenceKind::Acceleration, [xdd_star.len(), jdot_qdot.len()]),
@@ -268,6 +271,7 @@ impl TaskLevel {
         Ok(self.rows)
     }
 
+    #[inline(always)]
     fn store_reference(&mut self, r0: usize, k: usize, reference: &Reference<'_>) {
         self.activation[r0..r0 + k].fill(1.0);
         match reference {

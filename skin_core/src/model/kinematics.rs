@@ -182,6 +182,42 @@ pub fn point_jacobian(
     Ok(())
 }
 
+/// The row `dᵀ J_v` of the point `point_in_frame` of frame `frame`: the linear rows of
+/// [`point_jacobian`] along the world direction `d`, into `out` (length nv), without forming the
+/// 6 × nv Jacobian (one skin cell's force row, paper 000 eq. 4 and 6). Each entry is summed as
+/// [`crate::hierarchy::TaskLevel::push_directional`] sums `dᵀ J_v`, so the row is the same to
+/// the bit.
+pub fn point_jacobian_along(
+    model: &RobotModel,
+    data: &ModelData,
+    frame: usize,
+    point_in_frame: &Vector3<f64>,
+    direction: &Vector3<f64>,
+    out: &mut [f64],
+) -> Result<(), ModelError> {
+    check_point(model, frame, point_in_frame)?;
+    if out.len() != model.nv() {
+        return Err(ModelError::Dimension { what: "jacobian row length", expected: model.nv(), got: out.len() });
+    }
+    let p = (data.frame_pose[frame] * Point3::from(*point_in_frame)).coords;
+    let along = |l: [f64; 3]| -> f64 { direction.iter().zip(l).map(|(d, l)| d * l).sum() };
+    // joints that do not move the frame: a zero column (dᵀ 0, its zero signed as the sum gives it)
+    out.fill(along([0.0; 3]));
+    let mut k = model.frames[frame].body;
+    while let Some(j) = k {
+        let a = &data.axis_w[j];
+        out[j] = match model.bodies[j].kind {
+            JointKind::Revolute => {
+                let l = a.cross(&(p - data.body_pos[j]));
+                along([l[0], l[1], l[2]])
+            }
+            JointKind::Prismatic => along([a[0], a[1], a[2]]),
+        };
+        k = model.bodies[j].parent;
+    }
+    Ok(())
+}
+
 /// `J̇ q̇` of the point `point_in_frame` of frame `frame` (linear first, then angular): the
 /// classical acceleration of the point (including the centripetal `ω × (ω × r)` term) and the
 /// angular acceleration of the frame when q̈ = 0. Matches pinocchio's

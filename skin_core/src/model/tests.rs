@@ -230,6 +230,29 @@ fn point_jacobian_matches_finite_differences() {
 }
 
 #[test]
+fn point_jacobian_along_is_the_linear_rows_along_the_direction_to_the_bit() {
+    for model in [tomm(), planar7()] {
+        let mut d = ModelData::new(&model);
+        let (q, qd, _) = Rng(29).state(&model);
+        update_kinematics(&model, &mut d, &q, &qd).unwrap();
+        let mut row = vec![0.0; model.nv()];
+        for (f, p) in probe_frames(&model) {
+            let j = jac(&model, &d, f, &p);
+            for dir in [Vector3::new(0.3, -0.5, 0.8), Vector3::new(-0.6, -0.0, -0.8)] {
+                point_jacobian_along(&model, &d, f, &p, &dir, &mut row).unwrap();
+                for (k, x) in row.iter().enumerate() {
+                    let expected: f64 = dir.iter().zip(j.column(k).iter()).map(|(d, j)| d * j).sum();
+                    assert_eq!(x.to_bits(), expected.to_bits(), "{} frame {f} joint {k}", model.name());
+                }
+            }
+        }
+    }
+    let model = planar7();
+    let d = ModelData::new(&model);
+    assert!(point_jacobian_along(&model, &d, 0, &Vector3::zeros(), &Vector3::x(), &mut [0.0; 3]).is_err());
+}
+
+#[test]
 fn jacobian_dot_qdot_matches_finite_differences() {
     for model in [tomm(), planar7()] {
         let mut d = ModelData::new(&model);

@@ -336,7 +336,8 @@ mod tests {
         r[11] = CellReading::uniform(0.005, 0.0); // below the activity threshold
         let (mut all, mut live) = (Vec::new(), Vec::new());
         aggregate_patches(&l, &r, &fusion(0.5), &mut all).unwrap();
-        aggregate_live_patches(&l, &LiveCells::from_readings(&r), &fusion(0.5), &mut live).unwrap();
+        let prox = crate::skin::characteristic::ProximityCharacteristic { range_m: 0.2, decay_m: 0.05 };
+        aggregate_live_patches(&l, &LiveCells::from_readings(&r, &prox), &fusion(0.5), &mut live).unwrap();
         assert_eq!(all, live);
         assert_eq!(live.iter().map(|w| w.active_cells).collect::<Vec<_>>(), [1, 2]);
     }

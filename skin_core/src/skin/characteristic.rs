@@ -95,6 +95,12 @@ pub struct PreparedProximity {
 }
 
 impl PreparedProximity {
+    /// Sensing range \[m\]: at and beyond this distance the signal is 0.
+    #[inline]
+    pub fn range_m(&self) -> f64 {
+        self.range_m
+    }
+
     /// Signal for a distance \[m\]. Negative distances count as contact (1), NaN counts as
     /// "nothing detected" (0), `+Inf` and anything at or beyond `range_m` gives 0.
     #[inline]

@@ -10,15 +10,12 @@
 //! `activation_band_m` of the range (`docs/tasks.md`): a cell entering the range changes neither
 //! the torque (`F_di = 0` there) nor the projector of the lower levels by a step.
 
-use nalgebra::Matrix6xX;
-
 use super::params::AvoidanceParams;
 use super::point_rows::{push_inward_cell_row, row_activation};
 use super::TaskError;
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::LengthMismatch;
-use crate::skin::characteristic::ProximityCharacteristic;
 use crate::skin::layout::{ResolvedCell, ResolvedLayout};
 use crate::skin::repulsion::linear_repulsion;
 use crate::skin::live::LiveCells;
@@ -28,7 +25,8 @@ use crate::skin::live::LiveCells;
 pub struct ProximityAvoidance {
     /// `K` and the nominal `d_range`.
     pub params: AvoidanceParams,
-    jac: Matrix6xX<f64>,
+    /// Scratch: one cell's Jacobian row.
+    row: Vec<f64>,
 }
 
 /// Summary of one avoidance update, for the supervisor.
@@ -47,26 +45,25 @@ pub struct AvoidanceSummary {
 impl ProximityAvoidance {
     /// The task for a model with `nv` joints; its level needs `layout.num_cells()` rows.
     pub fn new(nv: usize, params: AvoidanceParams) -> Self {
-        Self { params, jac: Matrix6xX::zeros(nv) }
+        Self { params, row: vec![0.0; nv] }
     }
 
-    /// Fills `level` (force rows) from the non-silent cells of this cycle's readings with the
-    /// sensing range `range_m` of this cycle, capped by the characteristic's range.
-    #[allow(clippy::too_many_arguments)]
+    /// Fills `level` (force rows) from the non-silent cells of this cycle's readings (with their
+    /// distances) with the sensing range `range_m` of this cycle, capped by the proximity
+    /// characteristic's range.
     pub fn update(
         &mut self,
         model: &RobotModel,
         data: &ModelData,
         layout: &ResolvedLayout,
         cells: &LiveCells,
-        proximity: &ProximityCharacteristic,
         range_m: f64,
         level: &mut TaskLevel,
     ) -> Result<AvoidanceSummary, TaskError> {
         level.clear();
-        let jac = &mut self.jac;
-        self.params.cells_in_range(layout, cells, proximity, range_m, |cell, fa| {
-            push_inward_cell_row(model, data, cell, fa, jac, level)
+        let row = &mut self.row;
+        self.params.cells_in_range(layout, cells, range_m, |cell, fa| {
+            push_inward_cell_row(model, data, cell, fa, row, level)
         })
     }
 
@@ -76,40 +73,34 @@ impl ProximityAvoidance {
         &self,
         layout: &ResolvedLayout,
         cells: &LiveCells,
-        proximity: &ProximityCharacteristic,
         range_m: f64,
     ) -> Result<AvoidanceSummary, TaskError> {
-        self.params.cells_in_range(layout, cells, proximity, range_m, |_, _| Ok(()))
+        self.params.cells_in_range(layout, cells, range_m, |_, _| Ok(()))
     }
 }
 
 impl AvoidanceParams {
     /// Calls `row(cell, (F_di, a_i))` for every cell within the range (eq. 3) and sums them up;
     /// `a_i` is the row's activation over the outer `activation_band_m` of the range. Only the
-    /// non-silent cells can be in range (a silent cell's proximity signal is 0).
+    /// non-silent cells can be in range (a silent cell's proximity signal is 0); their distances
+    /// `d_i` come with them ([`LiveCells::distances`]).
     fn cells_in_range(
         &self,
         layout: &ResolvedLayout,
         cells: &LiveCells,
-        proximity: &ProximityCharacteristic,
         range_m: f64,
         mut row: impl FnMut(&ResolvedCell, (f64, f64)) -> Result<(), TaskError>,
     ) -> Result<AvoidanceSummary, TaskError> {
         LengthMismatch::check_count(layout, cells.num_cells())?;
         let mut s = AvoidanceSummary { min_distance_m: f64::INFINITY, ..Default::default() };
-        let range = range_m.min(proximity.range_m);
+        let range = range_m.min(cells.proximity_range_m());
         if range.is_nan() || range <= 0.0 {
             return Ok(s);
         }
-        let prox = proximity.prepared();
         let band = self.activation_band_m.min(range);
         let mut sum_sq = 0.0;
-        for (i, reading) in cells.cells() {
-            let p = reading.proximity_signal();
-            if p <= 0.0 {
-                continue;
-            }
-            let d = prox.distance_m(p);
+        // a cell without proximity signal is at `range_m`, out of range
+        for ((i, _), &d) in cells.cells().iter().zip(cells.distances()) {
             if d >= range {
                 continue;
             }

@@ -8,8 +8,6 @@
 //! characteristic of the cell's force signal, for cells above the activity threshold. A row's
 //! activation in the null-space projector rises smoothly with `F_i` (`activation_force_n`).
 
-use nalgebra::Matrix6xX;
-
 use super::params::ContactReactionParams;
 use super::point_rows::{push_inward_cell_row, row_activation};
 use super::TaskError;
@@ -25,7 +23,8 @@ use crate::skin::live::LiveCells;
 pub struct ContactReaction {
     /// Gain and saturation.
     pub params: ContactReactionParams,
-    jac: Matrix6xX<f64>,
+    /// Scratch: one cell's Jacobian row.
+    row: Vec<f64>,
 }
 
 /// Summary of one contact-reaction update, for the supervisor.
@@ -42,7 +41,7 @@ pub struct ContactSummary {
 impl ContactReaction {
     /// The task for a model with `nv` joints; its level needs `layout.num_cells()` rows.
     pub fn new(nv: usize, params: ContactReactionParams) -> Self {
-        Self { params, jac: Matrix6xX::zeros(nv) }
+        Self { params, row: vec![0.0; nv] }
     }
 
     /// Fills `level` (force rows) from the non-silent cells of this cycle's readings.
@@ -58,9 +57,9 @@ impl ContactReaction {
         level: &mut TaskLevel,
     ) -> Result<ContactSummary, TaskError> {
         level.clear();
-        let jac = &mut self.jac;
+        let row = &mut self.row;
         self.params.contact_cells(layout, cells, force, fusion, |cell, fa| {
-            push_inward_cell_row(model, data, cell, fa, jac, level)
+            push_inward_cell_row(model, data, cell, fa, row, level)
         })
     }
 

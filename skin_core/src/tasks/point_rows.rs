@@ -6,7 +6,7 @@ use nalgebra::{Matrix6xX, Vector3, Vector6};
 
 use super::{rows_times_qd, TaskError};
 use crate::hierarchy::{Reference, TaskLevel};
-use crate::model::{point_jacobian, point_jacobian_dot_qdot, ModelData, RobotModel};
+use crate::model::{point_jacobian, point_jacobian_along, point_jacobian_dot_qdot, ModelData, RobotModel};
 use crate::skin::layout::ResolvedCell;
 
 /// Linear rows of a 6-row point Jacobian start here.
@@ -68,18 +68,18 @@ impl PointRows {
 
 /// Pushes one force row `f` [N] along the inward normal `−n` of `cell` (world axes), at the cell:
 /// the row `−nᵀ J_v(p)` of paper 000 eq. (4) / (6), with activation `a` in the null-space
-/// projector ([`TaskLevel::push_directional_activated`]). `jac` is scratch space (6 × nv).
+/// projector ([`TaskLevel::push_row_activated`]). `row` is scratch space (nv).
 pub(crate) fn push_inward_cell_row(
     model: &RobotModel,
     data: &ModelData,
     cell: &ResolvedCell,
     (f, a): (f64, f64),
-    jac: &mut Matrix6xX<f64>,
+    row: &mut [f64],
     level: &mut TaskLevel,
 ) -> Result<(), TaskError> {
     let inward = -(data.frame_pose(cell.frame).rotation * cell.normal_link);
-    point_jacobian(model, data, cell.frame, &cell.position_link, jac)?;
-    level.push_directional_activated(inward.as_slice(), &jac.fixed_rows::<3>(LINEAR), f, a)?;
+    point_jacobian_along(model, data, cell.frame, &cell.position_link, &inward, row)?;
+    level.push_row_activated(row, f, a)?;
     Ok(())
 }
 

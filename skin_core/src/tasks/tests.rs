@@ -134,7 +134,7 @@ fn avoidance_rows_magnitude_and_zero_range() {
     let mut task = ProximityAvoidance::new(s.model.nv(), s.params.avoidance);
     let mut level = TaskLevel::new("avoid", s.model.nv(), n);
     let range = s.params.avoidance.range_m;
-    let sum = task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings), &s.skin.proximity, range, &mut level).unwrap();
+    let sum = task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), range, &mut level).unwrap();
     assert_eq!((level.rows(), sum.rows), (1, 1));
     assert_relative_eq!(level.target()[0], s.params.avoidance.gain_n_per_m * (range - d), epsilon = 1e-9);
     assert_relative_eq!(sum.force_norm_n, level.target()[0], epsilon = 1e-12);
@@ -146,7 +146,7 @@ fn avoidance_rows_magnitude_and_zero_range() {
     point_jacobian(&s.model, &s.data, cell.frame, &cell.position_link, &mut j).unwrap();
     assert!((j.fixed_rows::<3>(0) * qdd).dot(&nw) < 0.0);
     // the supervisor's range 0 disables the task
-    let sum = task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings), &s.skin.proximity, 0.0, &mut level).unwrap();
+    let sum = task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), 0.0, &mut level).unwrap();
     assert_eq!((level.rows(), sum.rows), (0, 0));
     assert_eq!(sum.force_norm_n, 0.0);
 }
@@ -166,7 +166,7 @@ fn avoidance_row_fades_in_at_the_range_boundary() {
         let d = range - k as f64 * 1e-3;
         let mut readings = vec![CellReading::uniform(0.0, 0.0); n];
         readings[5].proximity = s.skin.proximity.signal(d);
-        task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings), &s.skin.proximity, range, &mut level).unwrap();
+        task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), range, &mut level).unwrap();
         assert!(level.is_activated());
         let a = level.activation()[0];
         assert!(a >= prev && a - prev < 0.05, "activation {a} after {prev} at d = {d}");
@@ -187,7 +187,7 @@ fn contact_reaction_moves_touched_cell_along_minus_n() {
     readings[c] = CellReading::uniform(0.5, 1.0);
     let mut task = ContactReaction::new(s.model.nv(), s.params.contact_reaction);
     let mut level = TaskLevel::new("contact", s.model.nv(), n);
-    let sum = task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings), &s.skin.force, &s.skin.fusion, &mut level).unwrap();
+    let sum = task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), &s.skin.force, &s.skin.fusion, &mut level).unwrap();
     assert_eq!(level.rows(), 1);
     let expected = (s.params.contact_reaction.gain * s.skin.force.force_n(0.5)).min(s.params.contact_reaction.max_force_n);
     assert_relative_eq!(sum.max_force_n, expected, epsilon = 1e-9);
@@ -373,7 +373,7 @@ fn three_tasks_and_posture_through_the_solver() {
     let mut posture = Posture::new(nv, &s.params.posture, &vec![0.0; nv]).unwrap();
     let mut levels = [TaskLevel::new("avoid", nv, n), TaskLevel::new("hand", nv, 1), TaskLevel::new("hold", nv, 3)];
     let [l0, l1, l2] = &mut levels;
-    let sum = avoid.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings), &s.skin.proximity, 0.1, l0).unwrap();
+    let sum = avoid.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), 0.1, l0).unwrap();
     assert!(sum.rows > 0);
     hand_task.update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.1 }, &s.skin.proximity, l1).unwrap();
     hold.update(&s.model, &s.data, l2).unwrap();

@@ -18,7 +18,7 @@ use thiserror::Error;
 
 use crate::interaction::Interactions;
 use crate::probe::ContactProbe;
-use crate::record::{CycleRecord, RunRecord, Switch};
+use crate::record::{mode_name, CycleRecord, RunRecord, Switch};
 use crate::schedule::{Schedule, ScheduleError, ScheduledInputs};
 use crate::scene::Scene;
 use crate::world::{World, WorldError};
@@ -117,6 +117,8 @@ impl ClosedLoop {
             cycles: Vec::new(),
             switches: Vec::new(),
             wall_time_s: 0.0,
+            mjcf: world.mjcf().to_string(),
+            key_frames: Vec::new(),
         };
         Ok(ClosedLoop {
             steps_per_cycle: (1.0 / (spec.control_rate_hz * spec.timestep_s)).round() as u64,
@@ -197,12 +199,16 @@ impl ClosedLoop {
             fault,
             compute_us,
         };
+        if self.record.cycles.is_empty() {
+            self.record.key_frame(&self.world, "start".into());
+        }
         if let Some(tr) = self.controller.supervisor().last_transition() {
             self.record.switches.push(Switch {
                 t_s: tr.t_s,
                 from: tr.from,
                 to: tr.to,
             });
+            self.record.key_frame(&self.world, format!("{} -> {}", mode_name(tr.from), mode_name(tr.to)));
         }
         let commands = &self.controller.output().commands;
         self.world
@@ -227,6 +233,7 @@ impl ClosedLoop {
             progress((k + 1) as f64 / cycles as f64);
         }
         self.record.wall_time_s = start.elapsed().as_secs_f64();
+        self.record.key_frame(&self.world, "end".into());
         self.record
     }
 }

@@ -17,7 +17,40 @@ use crate::report::{MetricsJson, RunOutput, RunReport, SummaryText};
 
 /// Every product of a run, as `skin_sim run` writes them: `metrics.json`, `summary.txt`,
 /// `figure.png`, `run.mcap`.
-pub const ALL: [&dyn RunOutput; 4] = [&MetricsJson, &SummaryText, &FigurePng, &RunBag];
+pub const ALL: [&dyn RunOutput; 5] = [&MetricsJson, &SummaryText, &FigurePng, &RunBag, &KeyFrames];
+
+/// Rendered key frames: `scene.xml` (the MJCF of the run) and `keyframes.json` (MuJoCo's state at
+/// the start, at the first switches and at the end), rendered to `keyframe_<k>_<t>s.png` by
+/// `scripts/render_keyframes.py` (MuJoCo's renderer through EGL). Where that is not possible (no
+/// EGL, no Python with mujoco, no script beside the binary's sources) `keyframes.txt` says why,
+/// and the run goes on.
+pub struct KeyFrames;
+
+impl RunOutput for KeyFrames {
+    fn write(&self, report: &RunReport, dir: &Path) -> anyhow::Result<PathBuf> {
+        let r = &report.record;
+        std::fs::write(dir.join("scene.xml"), &r.mjcf).context("writing scene.xml")?;
+        let frames = serde_json::to_string(&r.key_frames).context("key frames as JSON")?;
+        let json = dir.join("keyframes.json");
+        std::fs::write(&json, frames).with_context(|| format!("writing {}", json.display()))?;
+        let script = crate::scenario::config_dir().join("../scripts/render_keyframes.py");
+        let rendered = std::process::Command::new("python3")
+            .arg(&script)
+            .arg(dir)
+            .output()
+            .map_err(|e| format!("python3 {}: {e}", script.display()))
+            .and_then(|o| if o.status.success() { Ok(()) } else { Err(String::from_utf8_lossy(&o.stderr).trim().to_string()) });
+        match rendered {
+            Ok(()) => Ok(json),
+            Err(why) => {
+                let note = dir.join("keyframes.txt");
+                let text = format!("key frames not rendered (the states are in keyframes.json, the scene in scene.xml): {why}\n");
+                std::fs::write(&note, text).with_context(|| format!("writing {}", note.display()))?;
+                Ok(note)
+            }
+        }
+    }
+}
 
 /// `figure.png`: paper 000's panels (arrangement, ee speed, proximity and contact force, torque)
 /// for a paper 000 scenario, paper 003's force-tracking panels for a scene of paper 003's phases

@@ -64,6 +64,22 @@ pub struct Switch {
     pub to: Mode,
 }
 
+/// The simulation's state at one moment of a run, for rendering (`keyframes.json`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct KeyFrame {
+    /// Simulation time \[s\].
+    pub t_s: f64,
+    /// What happens then (`start`, `end`, a switch `(a) -> (b)`).
+    pub label: String,
+    /// MuJoCo `qpos` (robot joints, movable objects).
+    pub qpos: Vec<f64>,
+    /// MuJoCo `mocap_pos` (persons).
+    pub mocap_pos: Vec<[f64; 3]>,
+}
+
+/// Most key frames one run keeps: the start, the first switches, the end.
+pub const MAX_KEY_FRAMES: usize = 8;
+
 /// A whole run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunRecord {
@@ -93,9 +109,27 @@ pub struct RunRecord {
     pub switches: Vec<Switch>,
     /// Wall-clock duration of the run \[s\].
     pub wall_time_s: f64,
+    /// The MJCF the run simulated (primitive geoms only: self-contained).
+    pub mjcf: String,
+    /// The state at the start, at the first switches and at the end (at most [`MAX_KEY_FRAMES`]).
+    pub key_frames: Vec<KeyFrame>,
 }
 
 impl RunRecord {
+    /// Keeps `world`'s state as a key frame labelled `label` (the last one replaced when full,
+    /// so that the end is always kept).
+    pub fn key_frame(&mut self, world: &crate::world::World, label: String) {
+        self.push_key_frame(world.key_frame(label));
+    }
+
+    /// Keeps `frame` (the last one replaced when [`MAX_KEY_FRAMES`] are kept).
+    pub fn push_key_frame(&mut self, frame: KeyFrame) {
+        if self.key_frames.len() == MAX_KEY_FRAMES {
+            self.key_frames.pop();
+        }
+        self.key_frames.push(frame);
+    }
+
     /// Simulated duration \[s\]: control cycles times the control period.
     pub fn sim_duration_s(&self) -> f64 {
         self.cycles.len() as f64 / self.control_rate_hz

@@ -16,6 +16,7 @@ use crate::lidar::Lidar;
 use crate::mjcf::{scene_xml, MjcfError};
 use crate::scene::spec::push_scale;
 use crate::scene::{Scene, SceneError};
+use crate::record::KeyFrame;
 use crate::skin_sensor::{SkinSensor, Touch};
 
 /// Errors building or driving a [`World`].
@@ -91,6 +92,7 @@ fn touches(pushes: &[Push], data: &MjData<Box<MjModel>>) -> Vec<Touch> {
 /// the LIDAR are sampled during the steps at their own rates (and once at construction).
 pub struct World {
     scene: Scene,
+    mjcf: String,
     data: MjData<Box<MjModel>>,
     /// Per model joint: its MuJoCo addresses when it moves (None: frozen).
     joints: Vec<Option<JointIo>>,
@@ -192,6 +194,7 @@ impl World {
         let lidar_every = spec.lidar.as_ref().map_or(0, |l| steps_per(l.rate_hz, spec.timestep_s));
         let n = model.nv();
         let mut world = World {
+            mjcf: xml,
             base: scene.moving_base(),
             data: MjData::new(Box::new(mj)),
             joints,
@@ -227,6 +230,16 @@ impl World {
     /// MuJoCo's model (read-only: for inspection, rendering, tests).
     pub fn mj_model(&self) -> &MjModel {
         self.data.model()
+    }
+
+    /// The current state as a key frame labelled `label`.
+    pub fn key_frame(&self, label: String) -> KeyFrame {
+        KeyFrame { t_s: self.time(), label, qpos: self.data.qpos().to_vec(), mocap_pos: self.data.mocap_pos().to_vec() }
+    }
+
+    /// The generated MJCF of the world.
+    pub fn mjcf(&self) -> &str {
+        &self.mjcf
     }
 
     /// MuJoCo's data (read-only).

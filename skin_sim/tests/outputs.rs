@@ -3,8 +3,8 @@
 
 use skin_sim::bag::msgs::{Arrangement, Float64MultiArray, JointState};
 use skin_sim::bag::read_bag;
-use skin_sim::outputs::{FigurePng, RunBag};
-use skin_sim::report::write_all;
+use skin_sim::outputs::{FigurePng, KeyFrames, RunBag};
+use skin_sim::report::{write_all, RunOutput};
 use skin_sim::runner::RunTarget;
 use skin_sim::scenario;
 use skin_sim::scene::RunOverrides;
@@ -39,4 +39,34 @@ fn figure_and_bag_of_a_run() {
         assert_eq!(first.mode, r.cycles[0].mode.as_u8());
         std::fs::remove_dir_all(&dir).unwrap();
     }
+}
+
+#[test]
+fn key_frames_are_rendered_or_the_reason_is_written() {
+    // intentional_contact's first 10 s: the start, the switch to intentional contact (8.8 s), the
+    // end. Rendered through EGL where it works (the bootstrap installs Mesa's); where it does not
+    // the note says why and the states are still there.
+    let target = RunTarget::from(scenario::find("intentional_contact").unwrap());
+    let report = target.run(&RunOverrides { duration_s: Some(10.0), ..RunOverrides::default() }, |_| {}).unwrap();
+    let labels: Vec<&str> = report.record.key_frames.iter().map(|k| k.label.as_str()).collect();
+    assert_eq!(labels, ["start", "avoidance -> intentional_contact", "end"]);
+    let dir = std::env::temp_dir().join(format!("skin_sim_keyframes_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = KeyFrames.write(&report, &dir).unwrap();
+    let states: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("keyframes.json")).unwrap()).unwrap();
+    assert_eq!(states.as_array().unwrap().len(), 3);
+    assert!(std::fs::read_to_string(dir.join("scene.xml")).unwrap().contains("<mujoco"));
+    let pngs: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().starts_with("keyframe_")).collect();
+    if file == dir.join("keyframes.json") {
+        assert_eq!(pngs.len(), 3, "one picture per key frame");
+        for p in &pngs {
+            let png = std::fs::read(p.path()).unwrap();
+            assert_eq!(&png[1..4], b"PNG");
+        }
+    } else {
+        let note = std::fs::read_to_string(&file).unwrap();
+        assert!(note.starts_with("key frames not rendered") && note.len() > 60, "{note}");
+        assert!(pngs.is_empty());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -11,7 +11,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use clap::{Parser, Subcommand};
-use skin_sim::outputs::{FigurePng, RunBag};
+use skin_sim::outputs::{FigurePng, KeyFrames, RunBag};
 use skin_sim::report::{write_all, MetricsJson, RunOutput, SummaryText};
 use skin_sim::runner::RunTarget;
 use skin_sim::scenario::SCENARIOS;
@@ -90,9 +90,9 @@ struct SweepArgs {
     quiet: bool,
 }
 
-/// The products of a run. The figure and the bag writers are added here.
+/// The products of a run (`skin_sim::outputs::ALL`).
 fn outputs() -> Vec<Box<dyn RunOutput>> {
-    vec![Box::new(MetricsJson), Box::new(SummaryText), Box::new(FigurePng), Box::new(RunBag)]
+    vec![Box::new(MetricsJson), Box::new(SummaryText), Box::new(FigurePng), Box::new(RunBag), Box::new(KeyFrames)]
 }
 
 /// A progress line on stderr, redrawn at most every 2 % of the run on a terminal (every 25 %

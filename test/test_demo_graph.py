@@ -17,7 +17,7 @@ from conftest import binary
 
 DURATION = 2.0
 PERIODS = int(DURATION * 500)  # the scene's control rate
-OUTPUTS = ("metrics.json", "summary.txt", "figure.png", "run.mcap")
+OUTPUTS = ("metrics.json", "summary.txt", "figure.png", "run.mcap", "scene.xml", "keyframes.json")
 WALL_CLOCK = {"realtime_factor", "control_cycle_us_p50"}
 
 
@@ -40,6 +40,8 @@ def test_graph_run_writes_every_output_with_skin_sims_metrics(runs):
     for name in OUTPUTS:
         assert (graph_dir / name).stat().st_size > 0, name
     assert (graph_dir / "figure.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    labels = [[k["label"] for k in json.loads((d / "keyframes.json").read_text())] for d in (graph_dir, local_dir)]
+    assert labels[0] == labels[1] and labels[0][0] == "start" and labels[0][-1] == "end", labels
     got = json.loads((graph_dir / "metrics.json").read_text())
     want = json.loads((local_dir / "metrics.json").read_text())
     assert set(got) == set(want)

@@ -119,15 +119,10 @@ impl RunRecord {
     /// Keeps `world`'s state as a key frame labelled `label` (the last one replaced when full,
     /// so that the end is always kept).
     pub fn key_frame(&mut self, world: &crate::world::World, label: String) {
-        self.push_key_frame(world.key_frame(label));
-    }
-
-    /// Keeps `frame` (the last one replaced when [`MAX_KEY_FRAMES`] are kept).
-    pub fn push_key_frame(&mut self, frame: KeyFrame) {
         if self.key_frames.len() == MAX_KEY_FRAMES {
             self.key_frames.pop();
         }
-        self.key_frames.push(frame);
+        self.key_frames.push(world.key_frame(label));
     }
 
     /// Simulated duration \[s\]: control cycles times the control period.

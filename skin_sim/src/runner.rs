@@ -14,7 +14,7 @@ use crate::interaction::Interactions;
 use crate::metrics::{self, Limits};
 use crate::outcome;
 use crate::probe::ContactProbe;
-use crate::record::{mode_name, CycleRecord, KeyFrame, RunRecord, Switch};
+use crate::record::{mode_name, CycleRecord, RunRecord, Switch};
 use crate::report::RunReport;
 use crate::scenario::{self, ForceTargets, Scenario};
 use crate::scene::{RunOverrides, Scene};
@@ -146,8 +146,6 @@ pub struct ExternalRun {
     interactions: Interactions,
     hand: Option<HandForceMap>,
     record: RunRecord,
-    /// The world's state at the last cycle (the `end` key frame).
-    latest: Option<KeyFrame>,
     started: Instant,
 }
 
@@ -165,7 +163,6 @@ impl ExternalRun {
             interactions: Interactions::new(&scene, config.tasks.base_avoidance),
             hand: HandForceMap::new(config),
             record: in_process.record().clone(),
-            latest: None,
             target: target.clone(),
             scene,
             started: Instant::now(),
@@ -185,7 +182,6 @@ impl ExternalRun {
             let label = format!("{} -> {}", mode_name(last.mode), mode_name(decision.mode));
             self.record.key_frame(world, label);
         }
-        self.latest = Some(world.key_frame("end".into()));
         let forces = self.probe.measure(world);
         // As the schedule gives it: a reference only with a hand to map it to.
         let (force_reference_n, force_reference_signal) = match (force_n, &self.hand) {
@@ -220,12 +216,11 @@ impl ExternalRun {
         self.record.cycles.len()
     }
 
-    /// The report; the wall time runs from [`ExternalRun::new`].
-    pub fn finish(mut self) -> RunReport {
+    /// The report, `world` at the end of the run (its last key frame); the wall time runs from
+    /// [`ExternalRun::new`].
+    pub fn finish(mut self, world: &crate::world::World) -> RunReport {
         self.record.wall_time_s = self.started.elapsed().as_secs_f64();
-        if let Some(end) = self.latest.take() {
-            self.record.push_key_frame(end);
-        }
+        self.record.key_frame(world, "end".into());
         self.target.report(self.record, &self.scene, self.limits)
     }
 }

@@ -367,14 +367,16 @@ impl SimHandle {
             });
             std::fs::write(path, serde_json::to_string(&json)?).with_context(|| format!("--record {}", path.display()))?;
         }
-        self.recorder.map(write_report).transpose()
+        let world = self.bridge.world();
+        self.recorder.map(|r| write_report(r, world)).transpose()
     }
 }
 
-/// The report of a recorded run into its directory, its summary on stdout.
-fn write_report(r: Recorder) -> Result<bool> {
+/// The report of a recorded run into its directory (`world`: its final state), its summary on
+/// stdout.
+fn write_report(r: Recorder, world: &skin_sim::World) -> Result<bool> {
     anyhow::ensure!(r.run.cycles() > 0, "--out {}: no control period was completed", r.dir.display());
-    let report = r.run.finish();
+    let report = r.run.finish(world);
     let files = skin_sim::report::write_all(&report, &r.dir, &skin_sim::outputs::ALL)?;
     print!("{}", report.summary());
     let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();

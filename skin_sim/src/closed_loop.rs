@@ -113,7 +113,6 @@ impl ClosedLoop {
             seed: spec.seed,
             eps_v_mps: controller.config().supervisor.thresholds.speed_mps,
             eps_c_n: controller.config().supervisor.thresholds.contact_force_n,
-            hand_distance_desired_m: controller.config().tasks.hand_force.distance_desired_m,
             cycles: Vec::new(),
             switches: Vec::new(),
             wall_time_s: 0.0,

@@ -74,8 +74,9 @@ impl RunOutput for FigurePng {
         let title = format!("{} (seed {}, {})", r.name, r.seed, scene);
         // Paper 003's phases (force tracking or the pre-contact approach) or paper 000's Table I.
         let phases = c.iter().any(|c| matches!(c.mode, Mode::PreContact | Mode::Contact));
-        let force_reference = c.iter().any(|c| !c.force_reference_n.is_nan());
-        let figure = if phases && !force_reference {
+        // a phase scene without force references: paper 003 Exp. 2 (its metrics have d_p,d)
+        let guidance = report.metrics.contact_free.as_ref().filter(|_| phases);
+        let figure = if let Some(g) = guidance {
             let base = |k: usize| r.joint_names.iter().position(|j| j == BASE_JOINTS[k]).map_or_else(|| vec![f64::NAN; c.len()], |j| column(c, |c| c.q[j]));
             let hand = |k: usize| column(c, |c| c.hand_position_m[k]);
             let distance = column(c, |c| if c.hand_distance_m.is_finite() { c.hand_distance_m } else { f64::NAN });
@@ -84,7 +85,7 @@ impl RunOutput for FigurePng {
                 &GuidanceSignals {
                     t: &t,
                     distance: &distance,
-                    distance_desired: &vec![r.hand_distance_desired_m; c.len()],
+                    distance_desired: &vec![g.hand_distance_desired_m; c.len()],
                     hand: [&hand(0), &hand(1), &hand(2)],
                     base: [&base(0), &base(1)],
                     interaction: &interactions,

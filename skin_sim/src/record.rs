@@ -101,8 +101,6 @@ pub struct RunRecord {
     pub eps_v_mps: f64,
     /// The supervisor's contact force limit `ε_c` \[N\] (paper 000 Table I).
     pub eps_c_n: f64,
-    /// `d_p,d` of the hand distance task \[m\] (paper 003 eq. (9), pre-contact).
-    pub hand_distance_desired_m: f64,
     /// One entry per control cycle, in time order.
     pub cycles: Vec<CycleRecord>,
     /// Arrangement switches in time order.

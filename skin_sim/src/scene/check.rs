@@ -110,12 +110,8 @@ pub(crate) fn check_values(spec: &SceneSpec) -> Checked {
 }
 
 fn check_base_motion(key: &str, m: &BaseMotionSpec) -> Checked {
-    non_negative(format!("{key}.start_s"), m.start_s)?;
-    if !(m.end_s.is_finite() && m.end_s > m.start_s) {
-        return Err(reject(format!("{key}.end_s"), format!("{} must be after start_s", m.end_s)));
-    }
     positive(format!("{key}.ramp_s"), m.ramp_s)?;
-    ramp_fits(key, m.ramp_s, m.start_s, m.end_s)?;
+    window(key, m.start_s, m.end_s, m.ramp_s)?;
     match (&m.circle, &m.swing) {
         (Some(c), None) => {
             positive(format!("{key}.circle.radius_m"), c.radius_m)?;
@@ -229,8 +225,13 @@ fn check_person(key: &str, p: &PersonSpec) -> Checked {
     Ok(())
 }
 
-/// The rise and the fall of a window's `ramp_s` fit in `[start_s, end_s]`.
-fn ramp_fits(key: &str, ramp_s: f64, start_s: f64, end_s: f64) -> Checked {
+/// A time window `[start_s, end_s)` from `start_s` >= 0 on, with room for the rise and the fall
+/// of its (checked) `ramp_s`.
+fn window(key: &str, start_s: f64, end_s: f64, ramp_s: f64) -> Checked {
+    non_negative(format!("{key}.start_s"), start_s)?;
+    if !(end_s.is_finite() && end_s > start_s) {
+        return Err(reject(format!("{key}.end_s"), format!("{end_s} must be after start_s")));
+    }
     if 2.0 * ramp_s > end_s - start_s {
         return Err(reject(format!("{key}.ramp_s"), format!("{ramp_s} s: the rise and the fall must fit in the window (at most half of it)")));
     }
@@ -240,12 +241,8 @@ fn ramp_fits(key: &str, ramp_s: f64, start_s: f64, end_s: f64) -> Checked {
 fn check_push(key: &str, p: &PushSpec, objects: &[ObjectSpec]) -> Checked {
     finite(format!("{key}.force_n"), &p.force_n)?;
     finite(format!("{key}.point_m"), &p.point_m)?;
-    non_negative(format!("{key}.start_s"), p.start_s)?;
-    if !(p.end_s.is_finite() && p.end_s > p.start_s) {
-        return Err(reject(format!("{key}.end_s"), format!("{} must be after start_s", p.end_s)));
-    }
     non_negative(format!("{key}.ramp_s"), p.ramp_s)?;
-    ramp_fits(key, p.ramp_s, p.start_s, p.end_s)?;
+    window(key, p.start_s, p.end_s, p.ramp_s)?;
     match (&p.object, &p.link) {
         (Some(o), None) => {
             if !objects.iter().any(|x| &x.name == o) {

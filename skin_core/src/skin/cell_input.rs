@@ -204,6 +204,14 @@ impl CellBuffer {
                 continue;
             }
             self.written_by[k] = self.messages;
+            // the common case first: three forces and a proximity, all in [0, 1] (NaN is not)
+            if let &[f0, f1, f2] = cell.force {
+                if [f0, f1, f2, cell.proximity].iter().all(|v| (0.0..=1.0).contains(v)) {
+                    let force = [f0, f1, f2].map(f64::from);
+                    self.readings[k] = CellReading { force, proximity: f64::from(cell.proximity) };
+                    continue;
+                }
+            }
             if cell.force.len() != 3 {
                 note(
                     &mut self.issues,

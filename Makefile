@@ -34,7 +34,7 @@ $(MSGS_STAMP): $(MSG_SRCS) | bootstrap
 	    --cmake-args -DPython3_EXECUTABLE=$(DEPS)/venv/bin/python -DBUILD_TESTING=OFF \
 	    > $(DEPS)/ros/colcon.log 2>&1 || { tail -40 $(DEPS)/ros/colcon.log; echo "colcon build of skin_msgs failed; full log: .deps/ros/colcon.log"; exit 1; }
 	@# r2r caches its generated bindings by environment only: drop them so changed messages are seen
-	@$(ENV) cargo clean --quiet -p r2r_msg_gen -p r2r
+	@$(ENV) cargo clean --quiet -p r2r_msg_gen -p r2r && cargo clean --quiet --release -p r2r_msg_gen -p r2r
 	@touch $@
 
 msgs: bootstrap $(MSGS_STAMP)

@@ -131,3 +131,17 @@ def set_parameter(node, target, name, value):
     req = SetParameters.Request()
     req.parameters = [Parameter(name=name, value=P(name, value=value).get_parameter_value())]
     return call_service(node, SetParameters, f"{target}/set_parameters", req).results[0]
+
+
+def cell_array(entries, stamp=None):
+    """A skin_msgs/SkinCellArray of `(cell_id, force[3], proximity)` cells (the arrays, cell k at
+    index k), stamped `stamp` (a builtin_interfaces/Time) if given."""
+    from skin_msgs.msg import SkinCellArray
+
+    msg = SkinCellArray()
+    msg.cell_id = [cell_id for cell_id, _, _ in entries]
+    msg.force = [float(v) for _, force, _ in entries for v in force]
+    msg.proximity = [float(prox) for _, _, prox in entries]
+    if stamp is not None:
+        msg.header.stamp = stamp
+    return msg

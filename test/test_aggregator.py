@@ -17,7 +17,7 @@ import pytest
 import yaml
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from conftest import TOP, binary, call_service, set_parameter, spin_until
+from conftest import TOP, binary, call_service, cell_array, set_parameter, spin_until
 
 NODE = "skin_aggregator"
 LAYOUT = TOP / "config" / "skin" / "tomm.yaml"
@@ -110,16 +110,8 @@ def check_patches(msg, layout, readings, w, threshold, sec):
 
 
 def cells_msg(sec, entries):
-    from skin_msgs.msg import SkinCell, SkinCellArray
-
-    msg = SkinCellArray()
+    msg = cell_array(entries)
     msg.header.stamp.sec = sec
-    for cell_id, force, prox in entries:
-        c = SkinCell()
-        c.cell_id = cell_id
-        c.force = [float(v) for v in force]
-        c.proximity = float(prox)
-        msg.cells.append(c)
     return msg
 
 

@@ -32,7 +32,6 @@ def expected(ts):
     def header(sec, frame):
         return T["std_msgs/msg/Header"](stamp=Time(sec=sec, nanosec=250_000_000), frame_id=frame)
 
-    cell = T["skin_msgs/msg/SkinCell"]
     task = T["skin_msgs/msg/TaskState"]
     return [
         ("/clock", 1 * S, T["rosgraph_msgs/msg/Clock"](clock=Time(sec=1, nanosec=0))),
@@ -53,11 +52,10 @@ def expected(ts):
             header=header(4, "base_laser"), angle_min=-1.5, angle_max=1.5, angle_increment=0.75,
             time_increment=0.0, scan_time=0.03125, range_min=0.0625, range_max=10.0,
             ranges=f32(1.0, 2.5, np.inf, 0.5, 3.25), intensities=f32())),
-        ("/skin/cells", 5 * S, T["skin_msgs/msg/SkinCellArray"](header=header(5, ""), cells=[
-            cell(cell_id=7, force=f32(0.25, 0.5, 0.75), proximity=0.125,
-                 acceleration=V3(x=0.0, y=0.1, z=9.81), temperature=31.5),
-            cell(cell_id=1042, force=f32(0.0, 0.0, 0.0), proximity=1.0,
-                 acceleration=V3(x=0.0, y=0.0, z=0.0), temperature=30.0)])),
+        ("/skin/cells", 5 * S, T["skin_msgs/msg/SkinCellArray"](
+            header=header(5, ""), cell_id=np.array([7, 1042], dtype=np.uint32),
+            force=f32(0.25, 0.5, 0.75, 0.0, 0.0, 0.0), proximity=f32(0.125, 1.0),
+            acceleration=f32(0.0, 0.1, 9.81, 0.0, 0.0, 0.0), temperature=f32(31.5, 30.0))),
         ("/skin/patches", 6 * S, T["skin_msgs/msg/PatchWrenchArray"](header=header(6, ""), patches=[
             T["skin_msgs/msg/PatchWrench"](
                 header=header(6, "patch_3"), patch_id=3, link="right_forearm_link",

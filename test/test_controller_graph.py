@@ -15,7 +15,7 @@ import pytest
 import yaml
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from conftest import TOP, binary, call_service, set_parameter, spin_until
+from conftest import TOP, binary, call_service, cell_array, set_parameter, spin_until
 
 QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST,
@@ -60,7 +60,6 @@ class Peer:
             return
         from nav_msgs.msg import Odometry
         from sensor_msgs.msg import JointState, LaserScan
-        from skin_msgs.msg import SkinCell, SkinCellArray
 
         now = self.node.get_clock().now().to_msg()
         for side, offset in (("left", 3), ("right", 9)):
@@ -75,9 +74,7 @@ class Peer:
                          range_max=8.0, ranges=[8.5] * 360)
         scan.header.stamp, scan.header.frame_id = now, "laser"
         self.scan.publish(scan)
-        cells = SkinCellArray(cells=[SkinCell(cell_id=self.cell_id, force=[0.0] * 3, proximity=0.6)])
-        cells.header.stamp = now
-        self.cells.publish(cells)
+        self.cells.publish(cell_array([(self.cell_id, [0.0] * 3, 0.6)], now))
 
     def call(self, srv_type, name, request):
         return call_service(self.node, srv_type, name, request)

@@ -20,7 +20,7 @@ import time
 import yaml
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from conftest import TOP, binary, spin_until
+from conftest import TOP, binary, cell_array, spin_until
 from test_controller_graph import ARMS, HOME, LATCHED
 
 DEEP = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST)
@@ -90,8 +90,6 @@ class FaultyRobot:
         """The inputs of one period, stamped `stamp` (bad: a bad value in each)."""
         from nav_msgs.msg import Odometry
         from sensor_msgs.msg import JointState, LaserScan
-        from skin_msgs.msg import SkinCell, SkinCellArray
-
         out = []
         for side in ("left", "right"):
             js = JointState(name=list(ARMS[side]), position=list(self.q[side]), velocity=list(self.cmd[side]))
@@ -117,15 +115,11 @@ class FaultyRobot:
             scan.ranges[5] = float("nan")  # read as no return
             scan.angle_increment = float("inf")
         out.append(("/scan", scan))
-        cells = [SkinCell(cell_id=self.cell_id, force=[0.0] * 3, proximity=0.5),
-                 SkinCell(cell_id=self.aggregator_cell, force=[0.2, 0.0, 0.0], proximity=0.0)]
+        cells = [(self.cell_id, [0.0] * 3, 0.5), (self.aggregator_cell, [0.2, 0.0, 0.0], 0.0)]
         if bad:
-            cells += [SkinCell(cell_id=self.cell_id, force=[0.0] * 3, proximity=0.9),
-                      SkinCell(cell_id=4_000_000, force=[0.0] * 3, proximity=0.5),
-                      SkinCell(cell_id=self.bad_cell, force=[float("nan"), 7.0, 0.0], proximity=-1.0)]
-        msg = SkinCellArray(cells=cells)
-        msg.header.stamp = stamp
-        out.append(("/skin/cells", msg))
+            cells += [(self.cell_id, [0.0] * 3, 0.9), (4_000_000, [0.0] * 3, 0.5),
+                      (self.bad_cell, [float("nan"), 7.0, 0.0], -1.0)]
+        out.append(("/skin/cells", cell_array(cells, stamp)))
         return out
 
     def integrate(self, dt):

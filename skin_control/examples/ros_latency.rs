@@ -12,7 +12,7 @@ use futures::{FutureExt, StreamExt};
 use r2r::builtin_interfaces::msg::Time;
 use r2r::nav_msgs::msg::Odometry;
 use r2r::sensor_msgs::msg::{JointState, LaserScan};
-use r2r::skin_msgs::msg::{SkinCell, SkinCellArray};
+use r2r::skin_msgs::msg::SkinCellArray;
 use r2r::std_msgs::msg::Float64MultiArray;
 use r2r::NativeMsg;
 use skin_control::qos;
@@ -60,20 +60,20 @@ fn main() -> Result<()> {
     let mut odom = Odometry::default();
     odom.pose.pose.orientation.w = 1.0;
     let mut scan = LaserScan { header: r2r::std_msgs::msg::Header { frame_id: "laser".into(), ..Default::default() }, angle_min: -std::f32::consts::PI, angle_max: std::f32::consts::PI, angle_increment: std::f32::consts::TAU / 360.0, range_min: 0.05, range_max: 8.0, ranges: vec![8.5; 360], ..Default::default() };
+    let n = config.layout.num_cells();
     let cells = SkinCellArray {
-        cells: config
-            .layout
-            .cells()
-            .iter()
-            .enumerate()
-            .map(|(i, c)| SkinCell { cell_id: c.id, proximity: if i % 60 == 0 { 0.6 } else { 0.0 }, ..Default::default() })
-            .collect(),
+        cell_id: config.layout.cells().iter().map(|c| c.id).collect(),
+        force: vec![0.0; 3 * n],
+        proximity: (0..n).map(|i| if i % 60 == 0 { 0.6 } else { 0.0 }).collect(),
+        // every signal a real cell sends: the acceleration (gravity) and the temperature too
+        acceleration: (0..n).flat_map(|_| [0.0, 0.0, 9.81]).collect(),
+        temperature: vec![30.0; n],
         ..Default::default()
     };
 
     // The skin driver keeps its message in the middleware's (C) form and updates it in place
     // each period, as a C++ driver would: r2r's `publish` of the Rust message would first copy
-    // 700 cells into a new C message (an allocation per cell).
+    // it into a new C message (an allocation per array).
     let mut cells = NativeMsg::<SkinCellArray>::from(&cells);
 
     // wait until the controller listens to every input

@@ -1,10 +1,12 @@
 //! The skin aggregator's work, without the node around it: cells in, patch wrenches and markers
 //! out (paper 003 eq. 6-8 through `skin_core::skin::aggregate`).
+use r2r::builtin_interfaces::msg::Time;
 use r2r::skin_msgs::msg::PatchWrenchArray;
 use r2r::visualization_msgs::msg::MarkerArray;
 use skin_core::skin::aggregate::{aggregate_patches, FusionParams, PatchWrench};
 use skin_core::skin::layout::ResolvedLayout;
 
+use crate::convert::cdr_cells::CdrCells;
 use crate::convert::{update_cells, write_patch_array, CellBuffer, CellMessage, Issue, IssueCounts};
 use crate::markers::SkinMarkers;
 
@@ -33,6 +35,10 @@ pub struct Aggregator {
     markers: SkinMarkers,
     patches_msg: PatchWrenchArray,
     markers_msg: MarkerArray,
+    cdr: CdrCells,
+    /// Stamp of the last cells read.
+    stamp: Time,
+    refused: u64,
 }
 
 impl Aggregator {
@@ -45,6 +51,9 @@ impl Aggregator {
             layout,
             patches_msg: PatchWrenchArray::default(),
             markers_msg: MarkerArray::default(),
+            cdr: CdrCells::default(),
+            stamp: Time::default(),
+            refused: 0,
         }
     }
 
@@ -58,27 +67,68 @@ impl Aggregator {
         self.cells.issues()
     }
 
+    /// Messages refused whole since the start (bytes that are no `SkinCellArray`, arrays that
+    /// disagree).
+    pub fn refused(&self) -> u64 {
+        self.refused
+    }
+
+    /// [`Self::process`] for a message's serialized bytes (`Node::subscribe_raw`).
+    pub fn process_cdr(
+        &mut self,
+        data: &[u8],
+        fusion: &FusionParams,
+        report: impl FnMut(&Issue),
+    ) -> Result<(&PatchWrenchArray, &MarkerArray), String> {
+        let mut cdr = std::mem::take(&mut self.cdr);
+        let parsed = cdr.parse(data);
+        let result = parsed.map_err(|e| self.refuse(e)).and_then(|()| self.read(&cdr, report));
+        self.cdr = cdr;
+        result?;
+        Ok(self.aggregate(fusion))
+    }
+
     /// Takes one `/skin/cells` message (issues go to `report`) and returns the `/skin/patches`
     /// message (every patch, stamped like the cells) and the `/skin/markers` update (empty when
-    /// RViz is already up to date).
+    /// RViz is already up to date). A message whose arrays disagree is refused (the reason).
     pub fn process(
         &mut self,
         msg: &impl CellMessage,
         fusion: &FusionParams,
         report: impl FnMut(&Issue),
-    ) -> (&PatchWrenchArray, &MarkerArray) {
-        update_cells(&mut self.cells, &self.layout, msg, report);
+    ) -> Result<(&PatchWrenchArray, &MarkerArray), String> {
+        self.read(msg, report)?;
+        Ok(self.aggregate(fusion))
+    }
+
+    fn refuse(&mut self, why: String) -> String {
+        self.refused += 1;
+        why
+    }
+
+    /// The cells of `msg` into the buffer; the stamp for the outputs.
+    fn read(&mut self, msg: &impl CellMessage, report: impl FnMut(&Issue)) -> Result<(), String> {
+        match update_cells(&mut self.cells, &self.layout, msg, report) {
+            Ok(()) => {
+                self.stamp = msg.stamp();
+                Ok(())
+            }
+            Err(e) => Err(self.refuse(e)),
+        }
+    }
+
+    fn aggregate(&mut self, fusion: &FusionParams) -> (&PatchWrenchArray, &MarkerArray) {
         let readings = self.cells.readings();
         aggregate_patches(&self.layout, readings, fusion, &mut self.wrenches)
             .expect("the cell buffer has one reading per layout cell");
-        let stamp = msg.stamp();
-        write_patch_array(&self.layout, &self.wrenches, &stamp, &mut self.patches_msg);
+        let stamp = &self.stamp;
+        write_patch_array(&self.layout, &self.wrenches, stamp, &mut self.patches_msg);
         self.markers.update(
             &self.layout,
             readings,
             fusion,
             &self.wrenches,
-            &stamp,
+            stamp,
             &mut self.markers_msg,
         );
         (&self.patches_msg, &self.markers_msg)
@@ -89,7 +139,8 @@ impl Aggregator {
 mod tests {
     use super::*;
     use crate::ros_params::flatten;
-    use r2r::skin_msgs::msg::{SkinCell, SkinCellArray};
+    use r2r::skin_msgs::msg::SkinCellArray;
+    use r2r::WrappedTypesupport;
     use skin_core::model::RobotModel;
     use skin_core::skin::layout::SkinLayout;
     use skin_core::skin::params::SkinParams;
@@ -123,19 +174,19 @@ mod tests {
             .fusion;
         let first = layout.cells()[0].id;
         let mut agg = Aggregator::new(layout);
-        let msg = SkinCellArray {
-            cells: vec![SkinCell {
-                cell_id: first,
-                force: vec![0.5; 3],
-                proximity: 0.5,
-                ..Default::default()
-            }],
-            ..Default::default()
-        };
-        let (patches, markers) = agg.process(&msg, &fusion, |i| panic!("{i}"));
+        let msg = SkinCellArray { cell_id: vec![first], force: vec![0.5; 3], proximity: vec![0.5], ..Default::default() };
+        let (patches, markers) = agg.process(&msg, &fusion, |i| panic!("{i}")).unwrap();
         assert_eq!(patches.patches.len(), 12);
         assert_eq!(patches.patches[0].active_cells, 1);
         assert_eq!(markers.markers.len(), 3);
+        let patches = patches.clone();
+        // the serialized bytes read as the message; bad bytes and disagreeing arrays are refused
+        let bytes = msg.to_serialized_bytes().unwrap();
+        assert_eq!(agg.process_cdr(&bytes, &fusion, |i| panic!("{i}")).unwrap().0, &patches);
+        assert!(agg.process_cdr(&bytes[..bytes.len() - 2], &fusion, |i| panic!("{i}")).unwrap_err().contains("ends inside"));
+        let short = SkinCellArray { force: vec![0.5; 2], ..msg.clone() };
+        assert!(agg.process(&short, &fusion, |i| panic!("{i}")).unwrap_err().starts_with("force has 2 values for 1 cells"));
+        assert_eq!(agg.refused(), 2);
         assert_eq!(agg.issues().total(), 0);
     }
 }

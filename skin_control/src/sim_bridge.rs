@@ -340,7 +340,7 @@ mod tests {
         let mut m = SkinCellArray::default();
         let mut ids = |readings: &[CellReading]| {
             write_events(&layout, readings, &Time::default(), &mut sent, &mut m);
-            m.cells.iter().map(|c| c.cell_id).collect::<Vec<_>>()
+            m.cell_id.clone()
         };
         let zero = CellReading::default();
         let touched = CellReading::uniform(0.0, 0.5);
@@ -350,8 +350,7 @@ mod tests {
         assert_eq!(ids(&[zero; 3]), [20]);
         assert!(ids(&[zero; 3]).is_empty());
         assert_eq!(ids(&[touched, zero, zero]), [10]);
-        assert_eq!(m.cells[0].force, [0.0; 3]);
-        assert_eq!(m.cells[0].proximity, 0.5);
+        assert_eq!((m.force.as_slice(), m.proximity.as_slice()), (&[0.0; 3][..], &[0.5][..]));
     }
 
     /// The graph's loop without DDS against skin_sim's in-process loop: the only difference is

@@ -142,22 +142,11 @@ fn samples(v: &mut impl Visit) -> Result<()> {
         5 * S,
         SkinCellArray {
             header: header(5, ""),
-            cells: vec![
-                SkinCell {
-                    cell_id: 7,
-                    force: [0.25, 0.5, 0.75],
-                    proximity: 0.125,
-                    acceleration: v3(0.0, 0.1, 9.81),
-                    temperature: 31.5,
-                },
-                SkinCell {
-                    cell_id: 1042,
-                    force: [0.0; 3],
-                    proximity: 1.0,
-                    acceleration: v3(0.0, 0.0, 0.0),
-                    temperature: 30.0,
-                },
-            ],
+            cell_id: vec![7, 1042],
+            force: vec![0.25, 0.5, 0.75, 0.0, 0.0, 0.0],
+            proximity: vec![0.125, 1.0],
+            acceleration: vec![0.0, 0.1, 9.81, 0.0, 0.0, 0.0],
+            temperature: vec![31.5, 30.0],
         },
     )?;
     v.visit(

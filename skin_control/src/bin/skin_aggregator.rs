@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context as _, Result};
 use clap::Parser;
 use futures::{executor::LocalPool, task::LocalSpawnExt, StreamExt};
-use r2r::skin_msgs::msg::{PatchWrenchArray, SkinCellArray};
+use r2r::skin_msgs::msg::PatchWrenchArray;
 use r2r::visualization_msgs::msg::MarkerArray;
 use r2r::{ParameterValue, RosParams};
 use skin_control::aggregator::{Aggregator, SKIN_PARAM_DESCRIPTIONS};
@@ -135,7 +135,8 @@ fn main() -> Result<()> {
     let (param_services, mut param_changes) = node
         .make_derived_parameter_handler(served)
         .context("declaring the parameters")?;
-    let mut cells = node.subscribe_native::<SkinCellArray>(CELLS_TOPIC, qos::every_sample())?;
+    // Read from the serialized bytes (convert::cdr_cells: no C message per message).
+    let mut cells = node.subscribe_raw(CELLS_TOPIC, nodes::topics::CELLS_TYPE, qos::every_sample())?;
     let patches_pub = node.create_publisher::<PatchWrenchArray>(PATCHES_TOPIC, qos::stream())?;
     let markers_pub = node.create_publisher::<MarkerArray>(MARKERS_TOPIC, qos::stream())?;
     r2r::log_info!(
@@ -172,12 +173,13 @@ fn main() -> Result<()> {
     let markers_out = markers_pub.clone();
     spawner.spawn_local(async move {
         let mut logged = [false; IssueKind::ALL.len()];
+        let mut logged_refusal = false;
         let mut publish_failed = false;
         while let Some(msg) = cells.next().await {
             let start = Instant::now();
             let fusion = params.lock().unwrap().value().fusion;
             let mut agg = agg.lock().unwrap();
-            let (patches, markers) = agg.process(&msg, &fusion, |issue| {
+            let read = agg.process_cdr(&msg, &fusion, |issue| {
                 // Each kind once, with an example; the counts go into the shutdown summary.
                 if !std::mem::replace(&mut logged[issue.kind as usize], true) {
                     r2r::log_warn!(
@@ -186,6 +188,15 @@ fn main() -> Result<()> {
                     );
                 }
             });
+            let (patches, markers) = match read {
+                Ok(out) => out,
+                Err(e) => {
+                    if !std::mem::replace(&mut logged_refusal, true) {
+                        r2r::log_warn!(&log, "{CELLS_TOPIC}: {e} (further refusals are counted, total at shutdown)");
+                    }
+                    continue;
+                }
+            };
             let built = start.elapsed();
             let sent = patches_pub
                 .publish(patches)
@@ -221,11 +232,14 @@ fn main() -> Result<()> {
     if let Err(e) = markers_pub.publish(&clear) {
         r2r::log_warn!(&logger, "{MARKERS_TOPIC}: clearing the markers failed: {e}");
     }
-    let issues = *aggregator.lock().unwrap().issues();
+    let (issues, refused) = {
+        let agg = aggregator.lock().unwrap();
+        (*agg.issues(), agg.refused())
+    };
     let (aggregation, cycle) = &*timing.lock().unwrap();
     r2r::log_info!(
         &logger,
-        "stopping after {} messages: aggregation {aggregation}, with publishing {cycle}; bad input: {issues}",
+        "stopping after {} messages: aggregation {aggregation}, with publishing {cycle}; bad input: {issues}; messages refused: {refused}",
         cycle.count
     );
     Ok(())

@@ -21,22 +21,56 @@ pub mod robot;
 use nalgebra::Vector3;
 use r2r::builtin_interfaces::msg::Time;
 use r2r::geometry_msgs::msg::{Point, Vector3 as Vector3Msg};
-use r2r::skin_msgs::msg::{PatchWrench as PatchWrenchMsg, PatchWrenchArray, SkinCell, SkinCellArray};
-use r2r::NativeMsg;
+use r2r::skin_msgs::msg::{PatchWrench as PatchWrenchMsg, PatchWrenchArray, SkinCellArray};
 use skin_core::skin::aggregate::PatchWrench;
 pub use skin_core::skin::cell_input::{CellBuffer, CellSample, Issue, IssueCounts, IssueKind};
 use skin_core::skin::layout::ResolvedLayout;
 use skin_core::skin::signals::CellReading;
 
-/// A `/skin/cells` message as the cell rules read it: r2r's Rust message, or the C message that a
-/// native subscription (`Node::subscribe_native`) takes it into. The nodes read the C message:
-/// r2r's Rust message costs an allocation per cell (its `force` is a `Vec`), and the cells are
-/// most of the graph's traffic (700 on TOMM).
+/// A `/skin/cells` message as the cell rules read it: r2r's Rust message (tests, the in-process
+/// simulation bridge) or [`cdr_cells::CdrCells`], read from the serialized bytes (the nodes).
 pub trait CellMessage {
     /// `header.stamp`.
     fn stamp(&self) -> Time;
-    /// The cells, in message order.
-    fn samples(&self) -> impl Iterator<Item = CellSample<'_>>;
+    /// The arrays: `cell_id`, `force`, `proximity`, and the lengths of `acceleration` and
+    /// `temperature` (checked, not read).
+    fn arrays(&self) -> CellArrays<'_>;
+}
+
+/// The signal arrays of a `SkinCellArray` (see the message's definition).
+#[derive(Debug, Clone, Copy)]
+pub struct CellArrays<'a> {
+    /// `cell_id`: n entries.
+    pub cell_id: &'a [u32],
+    /// `force`: 3n entries.
+    pub force: &'a [f32],
+    /// `proximity`: n entries.
+    pub proximity: &'a [f32],
+    /// Length of `acceleration`: 3n or 0.
+    pub acceleration_len: usize,
+    /// Length of `temperature`: n or 0.
+    pub temperature_len: usize,
+}
+
+impl<'a> CellArrays<'a> {
+    /// The cells in message order; an array whose length disagrees with `cell_id` is named.
+    pub fn samples(self) -> Result<impl Iterator<Item = CellSample<'a>>, String> {
+        let n = self.cell_id.len();
+        let check = |field: &str, len: usize, per_cell: usize, optional: bool| {
+            if len == per_cell * n || (optional && len == 0) {
+                Ok(())
+            } else {
+                let or_none = if optional { " or none" } else { "" };
+                Err(format!("{field} has {len} values for {n} cells ({per_cell} per cell{or_none}): message refused"))
+            }
+        };
+        check("force", self.force.len(), 3, false)?;
+        check("proximity", self.proximity.len(), 1, false)?;
+        check("acceleration", self.acceleration_len, 3, true)?;
+        check("temperature", self.temperature_len, 1, true)?;
+        let cells = self.cell_id.iter().zip(self.force.chunks_exact(3)).zip(self.proximity);
+        Ok(cells.map(|((&cell_id, force), &proximity)| CellSample { cell_id, force, proximity }))
+    }
 }
 
 impl CellMessage for SkinCellArray {
@@ -44,39 +78,29 @@ impl CellMessage for SkinCellArray {
         self.header.stamp.clone()
     }
 
-    fn samples(&self) -> impl Iterator<Item = CellSample<'_>> {
-        self.cells.iter().map(|c| CellSample { cell_id: c.cell_id, force: &c.force, proximity: c.proximity })
-    }
-}
-
-impl CellMessage for NativeMsg<SkinCellArray> {
-    fn stamp(&self) -> Time {
-        Time { sec: self.header.stamp.sec, nanosec: self.header.stamp.nanosec }
-    }
-
-    fn samples(&self) -> impl Iterator<Item = CellSample<'_>> {
-        let seq = &self.cells;
-        let cells = if seq.data.is_null() {
-            &[][..]
-        } else {
-            // SAFETY: a rosidl sequence: `data` points at `size` initialized cells, owned by the
-            // message, which the returned samples borrow.
-            unsafe { std::slice::from_raw_parts(seq.data, seq.size) }
-        };
-        cells.iter().map(|c| CellSample { cell_id: c.cell_id, force: &c.force, proximity: c.proximity })
+    fn arrays(&self) -> CellArrays<'_> {
+        CellArrays {
+            cell_id: &self.cell_id,
+            force: &self.force,
+            proximity: &self.proximity,
+            acceleration_len: self.acceleration.len(),
+            temperature_len: self.temperature.len(),
+        }
     }
 }
 
 /// Writes the cells of `msg` into `buf` (the rules of `skin_core::skin::cell_input`); `report`
-/// is called for every issue. No allocation.
-pub fn update_cells(buf: &mut CellBuffer, layout: &ResolvedLayout, msg: &impl CellMessage, report: impl FnMut(&Issue)) {
-    buf.update(layout, msg.samples(), report);
+/// is called for every issue. A message whose arrays disagree is refused whole: the reason names
+/// the array, `buf` is unchanged. No allocation.
+pub fn update_cells(buf: &mut CellBuffer, layout: &ResolvedLayout, msg: &impl CellMessage, report: impl FnMut(&Issue)) -> Result<(), String> {
+    buf.update(layout, msg.arrays().samples()?, report);
+    Ok(())
 }
 
 /// Writes the readings of the layout cells `k` with `keep(k)` into `msg`, in layout order (the
 /// simulation's skin driver; an event-driven skin keeps the cells that changed): ids from the
-/// layout, signals as the message's float32, acceleration and temperature zero. Reuses `msg`'s
-/// cells; a new one is built in Rust (r2r's `SkinCell::default` allocates a C message).
+/// layout, signals as the message's float32, no acceleration or temperature. Reuses `msg`'s
+/// arrays.
 pub fn write_cell_array(
     layout: &ResolvedLayout,
     readings: &[CellReading],
@@ -85,26 +109,19 @@ pub fn write_cell_array(
     msg: &mut SkinCellArray,
 ) {
     msg.header.stamp = stamp.clone();
-    let mut n = 0;
-    for (k, (cell, r)) in layout.cells().iter().zip(readings).enumerate() {
-        if !keep(k) {
-            continue;
-        }
-        if n == msg.cells.len() {
-            let zero = Vector3Msg { x: 0.0, y: 0.0, z: 0.0 };
-            msg.cells.push(SkinCell { cell_id: 0, force: Vec::with_capacity(3), proximity: 0.0, acceleration: zero, temperature: 0.0 });
-        }
-        let out = &mut msg.cells[n];
-        out.cell_id = cell.id;
-        out.force.clear();
-        out.force.extend(r.force.iter().map(|&f| f as f32));
-        out.proximity = r.proximity as f32;
-        n += 1;
+    for a in [&mut msg.force, &mut msg.proximity, &mut msg.acceleration, &mut msg.temperature] {
+        a.clear();
     }
-    msg.cells.truncate(n);
+    msg.cell_id.clear();
+    for (k, (cell, r)) in layout.cells().iter().zip(readings).enumerate() {
+        if keep(k) {
+            msg.cell_id.push(cell.id);
+            msg.force.extend(r.force.iter().map(|&f| f as f32));
+            msg.proximity.push(r.proximity as f32);
+        }
+    }
 }
 
-/// A normalized signal into [0, 1], with the issue it had, if any.
 /// TF frame name of patch `patch_id`'s frame {p_j}: `skin_patch_<id>`.
 pub fn patch_frame_id(patch_id: u32) -> String {
     let mut s = String::new();
@@ -290,7 +307,6 @@ pub fn read_patch_array(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use r2r::skin_msgs::msg::SkinCell;
     use skin_core::skin::aggregate::{aggregate_patches, FusionParams};
     use skin_core::skin::layout::SkinLayout;
     use skin_core::skin::signals::ForceReduction;
@@ -303,51 +319,69 @@ mod tests {
             .unwrap()
     }
 
-    fn cell(id: u32, force: [f32; 3], proximity: f32) -> SkinCell {
-        SkinCell {
-            cell_id: id,
-            force: force.to_vec(),
-            proximity,
-            ..Default::default()
-        }
-    }
-
-    fn cells(cells: Vec<SkinCell>) -> SkinCellArray {
+    /// A message of `(id, force, proximity)` cells.
+    fn cells(cells: &[(u32, [f32; 3], f32)]) -> SkinCellArray {
         SkinCellArray {
-            cells,
+            cell_id: cells.iter().map(|c| c.0).collect(),
+            force: cells.iter().flat_map(|c| c.1).collect(),
+            proximity: cells.iter().map(|c| c.2).collect(),
             ..Default::default()
         }
     }
 
     fn update(buf: &mut CellBuffer, l: &ResolvedLayout, msg: &SkinCellArray) -> Vec<Issue> {
         let mut issues = Vec::new();
-        update_cells(buf, l, msg, |i| issues.push(*i));
+        update_cells(buf, l, msg, |i| issues.push(*i)).unwrap();
         issues
     }
 
-    /// The C message of a native subscription reads exactly as r2r's Rust message: readings,
-    /// issues, stamp (every sanitize rule a C message can carry: its force has three values).
+    /// Cell k reads `cell_id[k]`, `force[3k..3k + 3]`, `proximity[k]`, with the sanitize rules.
     #[test]
-    fn native_cells_read_as_rust_cells() {
+    fn cells_read_from_the_arrays_by_index() {
         let l = layout();
-        let mut msg = cells(vec![
-            cell(11, [0.5, f32::NAN, 2.0], -0.5),
-            cell(99, [0.1; 3], 0.1),
-            cell(10, [0.25; 3], f32::INFINITY),
-            cell(11, [0.9; 3], 0.9),
-        ]);
-        msg.header.stamp = Time { sec: 3, nanosec: 7 };
-        let native = NativeMsg::from(&msg);
-        assert_eq!(native.stamp(), msg.stamp());
-        let (mut a, mut b) = (CellBuffer::new(&l), CellBuffer::new(&l));
-        let issues = update(&mut a, &l, &msg);
-        let mut native_issues = Vec::new();
-        update_cells(&mut b, &l, &native, |i| native_issues.push(*i));
-        assert_eq!(issues.len(), 6);
-        // (the NaN value of an issue is not equal to itself)
-        assert_eq!(format!("{native_issues:?}"), format!("{issues:?}"));
-        assert_eq!(a.readings(), b.readings());
-        assert_eq!(NativeMsg::from(&cells(Vec::new())).samples().count(), 0);
+        let mut buf = CellBuffer::new(&l);
+        let msg = cells(&[(11, [0.5, f32::NAN, 2.0], -0.5), (99, [0.1; 3], 0.1), (10, [0.25, 0.5, 0.75], 0.125), (11, [0.9; 3], 0.9)]);
+        let issues = update(&mut buf, &l, &msg);
+        let kinds: Vec<_> = issues.iter().map(|i| (i.cell_id, i.kind)).collect();
+        use IssueKind::*;
+        assert_eq!(kinds, [(11, NonFinite), (11, OutOfRange), (11, OutOfRange), (99, UnknownId), (11, DuplicateId)]);
+        let at = |id| buf.readings()[l.cell_index(id).unwrap()];
+        assert_eq!(at(10), CellReading { force: [0.25, 0.5, 0.75], proximity: 0.125 });
+        assert_eq!(at(11), CellReading { force: [0.5, 0.0, 1.0], proximity: 0.0 });
+    }
+
+    /// A force or proximity array that does not match `cell_id` (or an acceleration or
+    /// temperature array that is neither empty nor matching) refuses the message, naming the
+    /// array; the buffer keeps its readings.
+    #[test]
+    fn arrays_that_disagree_refuse_the_message() {
+        let l = layout();
+        let mut buf = CellBuffer::new(&l);
+        update(&mut buf, &l, &cells(&[(10, [0.5; 3], 0.5)]));
+        let before = buf.readings().to_vec();
+        let good = cells(&[(10, [0.1; 3], 0.1), (20, [0.2; 3], 0.2)]);
+        let mut bad = Vec::new();
+        let mut m = good.clone();
+        m.force.pop();
+        bad.push((m, "force has 5 values for 2 cells (3 per cell)"));
+        let mut m = good.clone();
+        m.proximity.push(0.0);
+        bad.push((m, "proximity has 3 values for 2 cells (1 per cell)"));
+        let mut m = good.clone();
+        m.acceleration = vec![0.0; 3];
+        bad.push((m, "acceleration has 3 values for 2 cells (3 per cell or none)"));
+        let mut m = good.clone();
+        m.temperature = vec![20.0];
+        bad.push((m, "temperature has 1 values for 2 cells (1 per cell or none)"));
+        for (m, want) in bad {
+            let e = update_cells(&mut buf, &l, &m, |_| panic!("no cell is read")).unwrap_err();
+            assert!(e.starts_with(want), "{e}");
+            assert_eq!(buf.readings(), &before[..]);
+        }
+        let mut m = good.clone();
+        (m.acceleration, m.temperature) = (vec![0.0; 6], vec![20.0; 2]);
+        assert!(update(&mut buf, &l, &m).is_empty());
+        assert_eq!(buf.readings()[l.cell_index(20).unwrap()].proximity, 0.2f32 as f64);
     }
 
     #[test]
@@ -357,7 +391,7 @@ mod tests {
         update(
             &mut buf,
             &l,
-            &cells(vec![cell(10, [0.5; 3], 0.2), cell(20, [0.0; 3], 0.8)]),
+            &cells(&[(10, [0.5; 3], 0.2), (20, [0.0; 3], 0.8)]),
         );
         let fusion = FusionParams {
             weight_force: 0.5,

@@ -390,11 +390,12 @@ impl TaskController {
         let stamp = msg.stamp();
         self.health.check_stamp(Timed::Cells, &stamp, self.clock(now_s), lead)?;
         let (table, first) = (&mut self.health.table, self.health.cell_kinds);
-        update_cells(&mut self.cells, &self.controller.config().layout, msg, |i| {
+        let read = update_cells(&mut self.cells, &self.controller.config().layout, msg, |i| {
             if table.count(first + i.kind as usize) {
                 report(i);
             }
         });
+        read.map_err(self.health.refuse(CELLS))?;
         self.cells_stamp = Some(stamp);
         Ok(())
     }

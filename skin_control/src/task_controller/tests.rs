@@ -3,7 +3,7 @@
 //! are refused; every bad input is counted in `/controller/state`.
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use r2r::sensor_msgs::msg::JointState;
-use r2r::skin_msgs::msg::{ControllerState, SkinCell, SkinCellArray};
+use r2r::skin_msgs::msg::{ControllerState, SkinCellArray};
 use skin_core::controller::ControllerConfig;
 
 use super::*;
@@ -36,8 +36,15 @@ fn joint_state(tc: &TaskController, t: f64, q: &[f64], qd: &[f64]) -> JointState
     }
 }
 
-fn cells(t: f64, cells: Vec<SkinCell>) -> SkinCellArray {
-    SkinCellArray { header: r2r::std_msgs::msg::Header { stamp: time_msg(t), ..Default::default() }, cells }
+/// A `/skin/cells` message of `(id, force, proximity)` cells stamped `t`.
+fn cells(t: f64, cells: &[(u32, [f32; 3], f32)]) -> SkinCellArray {
+    SkinCellArray {
+        header: r2r::std_msgs::msg::Header { stamp: time_msg(t), ..Default::default() },
+        cell_id: cells.iter().map(|c| c.0).collect(),
+        force: cells.iter().flat_map(|c| c.1).collect(),
+        proximity: cells.iter().map(|c| c.2).collect(),
+        ..Default::default()
+    }
 }
 
 fn command(out: &Outputs) -> Vec<f64> {
@@ -51,7 +58,7 @@ fn run_fresh(tc: &mut TaskController, mut t: f64, q: &mut [f64], v0: f64, n: usi
     let mut v = vec![v0; q.len()];
     for _ in 0..n {
         tc.on_joint_states(&joint_state(tc, t, q, &v), t, |_| {}).unwrap();
-        tc.on_cells(&cells(t, Vec::new()), t, |_| {}).unwrap();
+        tc.on_cells(&cells(t, &[]), t, |_| {}).unwrap();
         assert!(tc.input_age(t).unwrap().abs() < 1e-9);
         let out = tc.cycle(t, &time_msg(t));
         assert_eq!(out.state.unwrap().input_status, ControllerState::INPUT_FRESH as u8);
@@ -118,7 +125,7 @@ fn stamps_out_of_order_or_from_the_future_are_refused_and_counted() {
     assert!(e.reason.contains("stamp out of order"), "{e}");
     assert_eq!(tc.state.q()[0], 1.4, "the refused message wrote nothing");
     assert!(!tc.on_joint_states(&old, 10.01, |_| {}).unwrap_err().first, "logged once, counted always");
-    let future = cells(10.5, Vec::new());
+    let future = cells(10.5, &[]);
     let e = tc.on_cells(&future, 10.02, |_| {}).unwrap_err();
     assert!(e.to_string().starts_with("/skin/cells: header.stamp 10.500000 s: stamp in the future"), "{e}");
     tc.set_freshness(0.1, 1.0);
@@ -139,14 +146,14 @@ fn every_bad_input_is_counted_in_the_controller_state() {
     let mut reported = Vec::new();
     tc.on_joint_states(&js, 1.0, |i| reported.push(i.kind)).unwrap();
     let id = tc.controller().config().layout.cells()[0].id;
-    let bad = vec![
-        SkinCell { cell_id: id, force: vec![f32::NAN, 0.0, 0.0], proximity: 2.0, ..Default::default() },
-        SkinCell { cell_id: 999_999, ..Default::default() },
-    ];
+    let bad = cells(1.0, &[(id, [f32::NAN, 0.0, 0.0], 2.0), (999_999, [0.0; 3], 0.0)]);
     let mut cell_reports = 0;
-    tc.on_cells(&cells(1.0, bad.clone()), 1.0, |_| cell_reports += 1).unwrap();
-    tc.on_cells(&cells(1.0, bad), 1.0, |_| cell_reports += 1).unwrap();
+    tc.on_cells(&bad, 1.0, |_| cell_reports += 1).unwrap();
+    tc.on_cells(&bad, 1.0, |_| cell_reports += 1).unwrap();
     assert_eq!(cell_reports, 3, "the first of each kind is reported, the repeats only counted");
+    let disagreeing = SkinCellArray { proximity: vec![0.0], ..bad };
+    let e = tc.on_cells(&disagreeing, 1.0, |_| panic!("no cell is read")).unwrap_err();
+    assert!(e.reason.contains("proximity has 1 values for 2 cells"), "{}", e.reason);
     let mut goal = write_goal(&Isometry3::identity(), &time_msg(1.0), "world");
     goal.pose.position.x = f64::NAN;
     assert!(tc.on_goal(&goal).unwrap_err().reason.contains("pose.position.x = NaN"));
@@ -160,8 +167,9 @@ fn every_bad_input_is_counted_in_the_controller_state() {
     assert_eq!(count("/skin/cells: non-finite signal"), Some(2));
     assert_eq!(count("/skin/cells: signal outside [0, 1]"), Some(2));
     assert_eq!(count("/skin/cells: unknown cell id"), Some(2));
+    assert_eq!(count("/skin/cells: message refused"), Some(1));
     assert_eq!(count("/goal: message refused"), Some(1));
     assert_eq!(count("/hand_force_reference: message refused"), Some(1));
-    assert_eq!(state.issue_counts.iter().sum::<u64>(), 9);
+    assert_eq!(state.issue_counts.iter().sum::<u64>(), 10);
     assert_eq!(state.safe_stop_cycles, 0);
 }

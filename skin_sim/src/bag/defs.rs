@@ -46,7 +46,6 @@ const DEFINITIONS: &[(&str, &str)] = &[
     skin_msg!("ControllerState"),
     skin_msg!("PatchWrench"),
     skin_msg!("PatchWrenchArray"),
-    skin_msg!("SkinCell"),
     skin_msg!("SkinCellArray"),
     skin_msg!("TaskState"),
 ];

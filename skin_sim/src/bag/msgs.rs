@@ -255,28 +255,22 @@ pub struct Float64MultiArray {
     pub data: Vec<f64>,
 }
 
-/// `skin_msgs/SkinCell`.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct SkinCell {
-    /// Cell id from the skin layout.
-    pub cell_id: u32,
-    /// The three normalized force sensors, \[0, 1\].
-    pub force: [f32; 3],
-    /// Normalized proximity, \[0, 1\].
-    pub proximity: f32,
-    /// Acceleration in the cell frame \[m/s^2\].
-    pub acceleration: Vector3,
-    /// Temperature \[degC\].
-    pub temperature: f32,
-}
-
-/// `skin_msgs/SkinCellArray`.
+/// `skin_msgs/SkinCellArray`: one array per signal, cell k at index k (three values per cell
+/// for `force` and `acceleration`).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct SkinCellArray {
     /// Sampling time.
     pub header: Header,
-    /// The sampled cells.
-    pub cells: Vec<SkinCell>,
+    /// Cell ids from the skin layout, n.
+    pub cell_id: Vec<u32>,
+    /// The three normalized force sensors per cell, \[0, 1\], 3n.
+    pub force: Vec<f32>,
+    /// Normalized proximity per cell, \[0, 1\], n.
+    pub proximity: Vec<f32>,
+    /// Acceleration in the cell frame \[m/s^2\], 3n or none.
+    pub acceleration: Vec<f32>,
+    /// Temperature \[degC\], n or none.
+    pub temperature: Vec<f32>,
 }
 
 /// `skin_msgs/PatchWrench`.

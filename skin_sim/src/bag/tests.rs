@@ -59,17 +59,11 @@ fn every_topic_type_round_trips_through_a_file() {
     };
     let cells = SkinCellArray {
         header: header(5, ""),
-        cells: vec![SkinCell {
-            cell_id: 3,
-            force: [0.25, 0.5, 0.75],
-            proximity: 0.125,
-            acceleration: Vector3 {
-                x: 0.0,
-                y: 0.0,
-                z: 9.81,
-            },
-            temperature: 31.5,
-        }],
+        cell_id: vec![3, 1042],
+        force: vec![0.25, 0.5, 0.75, 0.0, 0.0, 0.0],
+        proximity: vec![0.125, 1.0],
+        acceleration: vec![0.0, 0.0, 9.81, 0.0, 0.1, 9.8],
+        temperature: vec![31.5, 30.0],
     };
     let state = ControllerState {
         header: header(5, ""),

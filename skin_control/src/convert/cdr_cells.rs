@@ -80,6 +80,10 @@ impl CdrCells {
         let (proximity, _) = c.words("proximity")?;
         let (_, acceleration_len) = c.words("acceleration")?;
         let (_, temperature_len) = c.words("temperature")?;
+        // the type support pads a message to a multiple of 4 bytes at most: more is another type
+        if payload.len() - c.pos >= 4 {
+            return Err(format!("{} bytes after temperature: not a skin_msgs/SkinCellArray of this definition", payload.len() - c.pos));
+        }
         read_words(ids, &mut self.cell_id, u32::from_le_bytes);
         read_words(force, &mut self.force, f32::from_le_bytes);
         read_words(proximity, &mut self.proximity, f32::from_le_bytes);
@@ -155,6 +159,9 @@ mod tests {
             let e = cells.parse(&bytes[..cut]).unwrap_err();
             assert!(["shorter", "ends inside"].iter().any(|w| e.contains(w)), "{cut}: {e}");
         }
+        let mut longer = bytes.clone();
+        longer.extend([0; 4]);
+        assert!(cells.parse(&longer).unwrap_err().contains("4 bytes after temperature"));
         let mut big_endian = bytes.clone();
         big_endian[1] = 0;
         assert!(cells.parse(&big_endian).unwrap_err().contains("little-endian"));

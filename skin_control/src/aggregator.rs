@@ -73,48 +73,25 @@ impl Aggregator {
         self.refused
     }
 
-    /// [`Self::process`] for a message's serialized bytes (`Node::subscribe_raw`).
-    pub fn process_cdr(
+    /// Takes one `/skin/cells` message as its serialized bytes (`Node::subscribe_raw`, read by
+    /// [`CdrCells`]; issues go to `report`) and returns the `/skin/patches` message (every patch,
+    /// stamped like the cells) and the `/skin/markers` update (empty when RViz is already up to
+    /// date). Bytes that are no `SkinCellArray` and arrays that disagree are refused (the reason)
+    /// and counted; the cells keep their readings.
+    pub fn process(
         &mut self,
         data: &[u8],
         fusion: &FusionParams,
         report: impl FnMut(&Issue),
     ) -> Result<(&PatchWrenchArray, &MarkerArray), String> {
-        let mut cdr = std::mem::take(&mut self.cdr);
-        let parsed = cdr.parse(data);
-        let result = parsed.map_err(|e| self.refuse(e)).and_then(|()| self.read(&cdr, report));
-        self.cdr = cdr;
-        result?;
-        Ok(self.aggregate(fusion))
-    }
-
-    /// Takes one `/skin/cells` message (issues go to `report`) and returns the `/skin/patches`
-    /// message (every patch, stamped like the cells) and the `/skin/markers` update (empty when
-    /// RViz is already up to date). A message whose arrays disagree is refused (the reason).
-    pub fn process(
-        &mut self,
-        msg: &impl CellMessage,
-        fusion: &FusionParams,
-        report: impl FnMut(&Issue),
-    ) -> Result<(&PatchWrenchArray, &MarkerArray), String> {
-        self.read(msg, report)?;
-        Ok(self.aggregate(fusion))
-    }
-
-    fn refuse(&mut self, why: String) -> String {
-        self.refused += 1;
-        why
-    }
-
-    /// The cells of `msg` into the buffer; the stamp for the outputs.
-    fn read(&mut self, msg: &impl CellMessage, report: impl FnMut(&Issue)) -> Result<(), String> {
-        match update_cells(&mut self.cells, &self.layout, msg, report) {
-            Ok(()) => {
-                self.stamp = msg.stamp();
-                Ok(())
-            }
-            Err(e) => Err(self.refuse(e)),
+        let cdr = &mut self.cdr;
+        let read = cdr.parse(data).and_then(|()| update_cells(&mut self.cells, &self.layout, cdr, report));
+        if let Err(e) = read {
+            self.refused += 1;
+            return Err(e);
         }
+        self.stamp = self.cdr.stamp();
+        Ok(self.aggregate(fusion))
     }
 
     fn aggregate(&mut self, fusion: &FusionParams) -> (&PatchWrenchArray, &MarkerArray) {
@@ -175,18 +152,20 @@ mod tests {
         let first = layout.cells()[0].id;
         let mut agg = Aggregator::new(layout);
         let msg = SkinCellArray { cell_id: vec![first], force: vec![0.5; 3], proximity: vec![0.5], ..Default::default() };
-        let (patches, markers) = agg.process(&msg, &fusion, |i| panic!("{i}")).unwrap();
+        let bytes = |m: &SkinCellArray| m.to_serialized_bytes().unwrap();
+        let (patches, markers) = agg.process(&bytes(&msg), &fusion, |i| panic!("{i}")).unwrap();
         assert_eq!(patches.patches.len(), 12);
         assert_eq!(patches.patches[0].active_cells, 1);
         assert_eq!(markers.markers.len(), 3);
-        let patches = patches.clone();
-        // the serialized bytes read as the message; bad bytes and disagreeing arrays are refused
-        let bytes = msg.to_serialized_bytes().unwrap();
-        assert_eq!(agg.process_cdr(&bytes, &fusion, |i| panic!("{i}")).unwrap().0, &patches);
-        assert!(agg.process_cdr(&bytes[..bytes.len() - 2], &fusion, |i| panic!("{i}")).unwrap_err().contains("ends inside"));
+        // cut bytes and disagreeing arrays are refused and counted; good bytes read on after them
+        let good = bytes(&msg);
+        assert!(agg.process(&good[..good.len() - 2], &fusion, |i| panic!("{i}")).unwrap_err().contains("ends inside"));
         let short = SkinCellArray { force: vec![0.5; 2], ..msg.clone() };
-        assert!(agg.process(&short, &fusion, |i| panic!("{i}")).unwrap_err().starts_with("force has 2 values for 1 cells"));
+        let e = agg.process(&bytes(&short), &fusion, |i| panic!("{i}")).unwrap_err();
+        assert!(e.starts_with("force has 2 values for 1 cells"), "{e}");
         assert_eq!(agg.refused(), 2);
+        let again = agg.process(&good, &fusion, |i| panic!("{i}")).unwrap().0;
+        assert_eq!(again.patches[0].active_cells, 1);
         assert_eq!(agg.issues().total(), 0);
     }
 }

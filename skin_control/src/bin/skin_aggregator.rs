@@ -179,7 +179,7 @@ fn main() -> Result<()> {
             let start = Instant::now();
             let fusion = params.lock().unwrap().value().fusion;
             let mut agg = agg.lock().unwrap();
-            let read = agg.process_cdr(&msg, &fusion, |issue| {
+            let read = agg.process(&msg, &fusion, |issue| {
                 // Each kind once, with an example; the counts go into the shutdown summary.
                 if !std::mem::replace(&mut logged[issue.kind as usize], true) {
                     r2r::log_warn!(

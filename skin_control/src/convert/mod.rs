@@ -61,7 +61,7 @@ impl<'a> CellArrays<'a> {
                 Ok(())
             } else {
                 let or_none = if optional { " or none" } else { "" };
-                Err(format!("{field} has {len} values for {n} cells ({per_cell} per cell{or_none}): message refused"))
+                Err(format!("{field} has {len} values for {n} cells ({per_cell} per cell{or_none})"))
             }
         };
         check("force", self.force.len(), 3, false)?;

@@ -84,6 +84,25 @@ pub(crate) fn norm(x: &[f64]) -> f64 {
 /// `ld` that is a multiple of it ([`padded_len`]), zero below row n, so no loop has a remainder.
 pub(crate) const BLOCK: usize = 8;
 
+/// `$body` with `$ld` a compile-time constant when it is one or two blocks (up to 16 joints):
+/// in a kernel, this lets the compiler unroll the loops down a column and drop their index
+/// checks (a macro, not a closure, so that each copy is surely compiled with its constant).
+macro_rules! with_const_ld {
+    ($ld:ident, $body:block) => {
+        match $ld {
+            BLOCK => {
+                let $ld = BLOCK;
+                $body
+            }
+            16 => {
+                let $ld = 16;
+                $body
+            }
+            _ => $body,
+        }
+    };
+}
+
 /// Column length of a padded matrix of `n` rows.
 pub(crate) fn padded_len(n: usize) -> usize {
     n.div_ceil(BLOCK) * BLOCK
@@ -97,7 +116,18 @@ avx2_dispatch! {
 
 #[inline(always)]
 fn mul_vec_padded_kernel(a: &[f64], x: &[f64], y: &mut [f64], ld: usize, q: usize) {
-    mul_vec_streams([a], [x], [y], ld, q);
+    mul_vec_streams::<1, false>([a], [x], [y], ld, q);
+}
+
+avx2_dispatch! {
+    /// `y (ld) += a (ld × q) · x (q)`, `a` and `y` padded: [`mul_vec_padded`] that starts each
+    /// sum from `y` (the sums of [`add_mul_vec`], in the same order).
+    add_mul_vec_padded => add_mul_vec_padded_kernel(a: &[f64], x: &[f64], y: &mut [f64], ld: usize, q: usize)
+}
+
+#[inline(always)]
+fn add_mul_vec_padded_kernel(a: &[f64], x: &[f64], y: &mut [f64], ld: usize, q: usize) {
+    mul_vec_streams::<1, true>([a], [x], [y], ld, q);
 }
 
 avx2_dispatch! {
@@ -108,31 +138,41 @@ avx2_dispatch! {
 
 #[inline(always)]
 fn mul_vec2_padded_kernel(a1: &[f64], a2: &[f64], x: &[f64], y1: &mut [f64], y2: &mut [f64], ld: usize, q: usize) {
-    mul_vec_streams([a1, a2], [x, x], [y1, y2], ld, q);
+    mul_vec_streams::<2, false>([a1, a2], [x, x], [y1, y2], ld, q);
 }
 
-/// `y_s (ld) = a_s (ld × q) · x_s (q)` for `S` products at once, `PASS` blocks of `BLOCK` rows
+/// `y_s (ld) = a_s (ld × q) · x_s (q)` (`ADD`: `+=`) for `S` products at once, `PASS` blocks of `BLOCK` rows
 /// per pass over the columns: every row's sum runs over the columns in order from 0 (as in
 /// [`mul_vec`]), but `S · PASS · BLOCK / 4` independent sums share a pass, so the adds' latency
 /// (a dependent chain of q adds per sum) overlaps instead of adding up.
 #[inline(always)]
-fn mul_vec_streams<const S: usize>(a: [&[f64]; S], x: [&[f64]; S], mut y: [&mut [f64]; S], ld: usize, q: usize) {
+fn mul_vec_streams<const S: usize, const ADD: bool>(a: [&[f64]; S], x: [&[f64]; S], mut y: [&mut [f64]; S], ld: usize, q: usize) {
     const PASS: usize = 2;
-    let blocks = ld / BLOCK;
-    let mut b = 0;
-    while b + PASS <= blocks {
-        mul_vec_pass::<S, PASS>(&a, &x, &mut y, ld, q, b);
-        b += PASS;
-    }
-    if b < blocks {
-        mul_vec_pass::<S, 1>(&a, &x, &mut y, ld, q, b);
-    }
+    with_const_ld!(ld, {
+        let blocks = ld / BLOCK;
+        let mut b = 0;
+        while b + PASS <= blocks {
+            mul_vec_pass::<S, PASS, ADD>(&a, &x, &mut y, ld, q, b);
+            b += PASS;
+        }
+        if b < blocks {
+            mul_vec_pass::<S, 1, ADD>(&a, &x, &mut y, ld, q, b);
+        }
+    });
 }
 
 /// Rows `b0 · BLOCK ..< (b0 + G) · BLOCK` of [`mul_vec_streams`].
 #[inline(always)]
-fn mul_vec_pass<const S: usize, const G: usize>(a: &[&[f64]; S], x: &[&[f64]; S], y: &mut [&mut [f64]; S], ld: usize, q: usize, b0: usize) {
+fn mul_vec_pass<const S: usize, const G: usize, const ADD: bool>(a: &[&[f64]; S], x: &[&[f64]; S], y: &mut [&mut [f64]; S], ld: usize, q: usize, b0: usize) {
     let mut acc = [[[0.0; BLOCK]; G]; S];
+    if ADD {
+        for (accs, ys) in acc.iter_mut().zip(y.iter()) {
+            for (g, acc) in accs.iter_mut().enumerate() {
+                acc.copy_from_slice(&ys[(b0 + g) * BLOCK..(b0 + g + 1) * BLOCK]);
+            }
+        }
+    }
+    let (a, x): ([&[f64]; S], [&[f64]; S]) = (std::array::from_fn(|s| &a[s][..ld * q]), std::array::from_fn(|s| &x[s][..q]));
     for k in 0..q {
         for s in 0..S {
             let xk = x[s][k];
@@ -179,15 +219,17 @@ avx2_dispatch! {
 #[inline(always)]
 fn sub_outer_mul_vec_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], x: &[f64], y: &mut [f64], ld: usize, q: usize) {
     const PASS: usize = 2;
-    let blocks = ld / BLOCK;
-    let mut b = 0;
-    while b + PASS <= blocks {
-        sub_outer_mul_vec_pass::<PASS>(a, u, v, x, y, ld, q, b);
-        b += PASS;
-    }
-    if b < blocks {
-        sub_outer_mul_vec_pass::<1>(a, u, v, x, y, ld, q, b);
-    }
+    with_const_ld!(ld, {
+        let blocks = ld / BLOCK;
+        let mut b = 0;
+        while b + PASS <= blocks {
+            sub_outer_mul_vec_pass::<PASS>(a, u, v, x, y, ld, q, b);
+            b += PASS;
+        }
+        if b < blocks {
+            sub_outer_mul_vec_pass::<1>(a, u, v, x, y, ld, q, b);
+        }
+    });
 }
 
 /// Rows `b0 · BLOCK ..< (b0 + G) · BLOCK` of [`sub_outer_mul_vec_padded`].
@@ -226,10 +268,10 @@ fn mul_padded_kernel(a: &[f64], b: &[f64], c: &mut [f64], ld: usize, q: usize, p
     let (b2, b1) = b[..q * p].split_at(q * (p / 2 * 2));
     for (cj, bj) in c2.chunks_exact_mut(2 * ld).zip(b2.chunks_exact(2 * q)) {
         let (c0, c1) = cj.split_at_mut(ld);
-        mul_vec_streams([a, a], [&bj[..q], &bj[q..]], [c0, c1], ld, q);
+        mul_vec_streams::<2, false>([a, a], [&bj[..q], &bj[q..]], [c0, c1], ld, q);
     }
     if !c1.is_empty() {
-        mul_vec_streams([a], [b1], [c1], ld, q);
+        mul_vec_streams::<1, false>([a], [b1], [c1], ld, q);
     }
 }
 
@@ -253,5 +295,56 @@ pub(crate) fn set_identity_padded(dst: &mut [f64], n: usize, ld: usize) {
     dst[..ld * n].fill(0.0);
     for (k, col) in dst[..ld * n].chunks_exact_mut(ld).enumerate() {
         col[k] = 1.0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(len: usize, seed: u64) -> Vec<f64> {
+        let mut s = seed;
+        (0..len)
+            .map(|_| {
+                s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+            })
+            .collect()
+    }
+
+    /// The padded kernels give the plain kernels' numbers to the bit, for column lengths of one
+    /// block, two blocks (the constant-length paths) and more (the general path).
+    #[test]
+    fn padded_kernels_are_the_plain_ones() {
+        for n in [1, 7, 8, 15, 16, 17, 30] {
+            let (ld, q) = (padded_len(n), n + 2);
+            let plain = sample(n * q, n as u64);
+            let mut a = vec![0.0; ld * q];
+            pad(&plain, &mut a, n, ld, q);
+            let (x, y0) = (sample(q, 7), sample(ld, 8).iter().enumerate().map(|(i, v)| if i < n { *v } else { 0.0 }).collect::<Vec<_>>());
+
+            let mut want = vec![0.0; n];
+            mul_vec(&plain, &x, &mut want, n, q);
+            let (mut got, mut got2) = (vec![0.0; ld], vec![0.0; ld]);
+            mul_vec_padded(&a, &x, &mut got, ld, q);
+            assert_eq!(got[..n], want[..], "mul_vec_padded, n = {n}");
+            mul_vec2_padded(&a, &a, &x, &mut got, &mut got2, ld, q);
+            assert_eq!((&got[..n], &got2[..n]), (&want[..], &want[..]), "mul_vec2_padded, n = {n}");
+
+            let mut want = y0[..n].to_vec();
+            add_mul_vec(&plain, &x, &mut want, n, q);
+            let mut got = y0.clone();
+            add_mul_vec_padded(&a, &x, &mut got, ld, q);
+            assert_eq!(got[..n], want[..], "add_mul_vec_padded, n = {n}");
+            assert!(got[n..].iter().all(|&v| v == 0.0), "padding stays zero");
+
+            let v = sample(q, 9);
+            let (mut want_a, mut want_y) = (a.clone(), vec![0.0; ld]);
+            sub_outer_padded(&mut want_a, &y0, &v, ld, q);
+            mul_vec_padded(&want_a, &x, &mut want_y, ld, q);
+            let (mut got_a, mut got_y) = (a.clone(), vec![0.0; ld]);
+            sub_outer_mul_vec_padded(&mut got_a, &y0, &v, &x, &mut got_y, ld, q);
+            assert_eq!((got_a, got_y), (want_a, want_y), "sub_outer_mul_vec_padded, n = {n}");
+        }
     }
 }

@@ -147,19 +147,24 @@ avx2_dispatch! {
     /// [`spd_inverse_from_cholesky`] from the padded factor `l` (ld × n) into the padded `minv`
     /// (ld × n, `dense::padded_len`): the same sums `Σ_k L⁻¹_ki L⁻¹_kj` in the same order, as
     /// rank-one updates with the rows `r_k` of `L⁻¹` (nonzero up to column k) down padded columns
-    /// instead of n² short dot products. `rows` (ld × n) receives the rows as padded columns,
-    /// `linv` (n × n) `L⁻¹`.
-    spd_inverse_padded => spd_inverse_padded_kernel(l: &[f64], linv: &mut [f64], rows: &mut [f64], minv: &mut [f64], n: usize, ld: usize)
+    /// instead of n² short dot products. `rows` (ld × n) receives the rows as padded columns.
+    spd_inverse_padded => spd_inverse_padded_kernel(l: &[f64], rows: &mut [f64], minv: &mut [f64], n: usize, ld: usize)
 }
 
-#[inline(always)]
-fn spd_inverse_padded_kernel(l: &[f64], linv: &mut [f64], rows: &mut [f64], minv: &mut [f64], n: usize, ld: usize) {
+/// `L⁻¹` (n × n, into `linv`) from the padded factor `l` (ld × n) of [`cholesky`], the same
+/// numbers as [`spd_inverse_from_cholesky`] gives; `rows` (ld × n) is scratch.
+pub(crate) fn lower_inverse_padded(l: &[f64], rows: &mut [f64], linv: &mut [f64], n: usize, ld: usize) {
     lower_inverse_rows(l, ld, rows, n, ld);
     for (k, rk) in rows[..ld * n].chunks_exact(ld).enumerate() {
         for (j, x) in rk[..n].iter().enumerate() {
             linv[j * n + k] = *x;
         }
     }
+}
+
+#[inline(always)]
+fn spd_inverse_padded_kernel(l: &[f64], rows: &mut [f64], minv: &mut [f64], n: usize, ld: usize) {
+    lower_inverse_rows(l, ld, rows, n, ld);
     // −M⁻¹ = −Σ_k r_k r_kᵀ (the columns j ≤ k that r_k reaches), then negated: exact
     minv[..ld * n].fill(0.0);
     for (k, rk) in rows[..ld * n].chunks_exact(ld).enumerate() {
@@ -211,9 +216,14 @@ fn transpose(src: &[f64], dst: &mut [f64], n: usize) {
 /// Wilkinson shifts (EISPACK `tred2`/`tql2`, as in the public-domain JAMA): about `9 m³` flops,
 /// a few times cheaper than cyclic Jacobi sweeps for the 10-20 stacked skin rows of a level,
 /// with eigenvalues accurate to `ε ‖A‖` (the rank threshold is `1e-12 e_max`, far above that).
+/// A 2 × 2 matrix takes one Jacobi rotation instead ([`symmetric_eigen_2x2`]).
 pub(crate) fn symmetric_eigen(a: &mut [f64], v: &mut [f64], m: usize) {
     if m <= 1 {
         v[..m].fill(1.0);
+        return;
+    }
+    if m == 2 {
+        symmetric_eigen_2x2(a, v);
         return;
     }
     v[..m * m].copy_from_slice(&a[..m * m]);
@@ -234,6 +244,25 @@ pub(crate) fn symmetric_eigen(a: &mut [f64], v: &mut [f64], m: usize) {
             }
         }
     }
+}
+
+/// [`symmetric_eigen`] of a 2 × 2 matrix: the Jacobi rotation `J = [c s; −s c]` that makes
+/// `Jᵀ A J` diagonal (Golub & Van Loan, Algorithm 8.5.1 `symSchur2`): with
+/// `τ = (a₁₁ − a₀₀) / (2 a₁₀)` and `t = sign(τ) / (|τ| + √(1 + τ²))` (the smaller rotation), the
+/// eigenvalues are `a₀₀ − t a₁₀` and `a₁₁ + t a₁₀`, exact to rounding, and the columns of `J`
+/// the eigenvectors. A quarter of the flops of the general path's reduction alone.
+fn symmetric_eigen_2x2(a: &mut [f64], v: &mut [f64]) {
+    let (a00, a10, a11) = (a[0], a[1], a[3]);
+    let (c, s, t) = if a10 == 0.0 {
+        (1.0, 0.0, 0.0)
+    } else {
+        let tau = (a11 - a00) / (2.0 * a10);
+        let t = 1.0f64.copysign(tau) / (tau.abs() + hypot(tau, 1.0));
+        let c = 1.0 / hypot(t, 1.0);
+        (c, t * c, t)
+    };
+    a[..4].copy_from_slice(&[a00 - t * a10, 0.0, 0.0, a11 + t * a10]);
+    v[..4].copy_from_slice(&[c, -s, s, c]);
 }
 
 /// Householder reduction of the symmetric matrix in `v` (column-major, `V(i, j) = v[j m + i]`)
@@ -411,11 +440,66 @@ fn tridiagonal_ql(v: &mut [f64], d: &mut [f64], e: &mut [f64], n: usize) {
 /// Damped, rank-aware inverse of the symmetric PSD `a` (m × m, destroyed): `out = V f(E) Vᵀ`
 /// with the filter of [`InverseParams`]. `v` and `w` are scratch (m × m).
 ///
+/// Rows (and columns) of `a` that are exactly zero come from task rows no joint moves (the
+/// out-of-plane row of a planar arm's position task, a row a higher level took whole): each is an
+/// eigenvalue 0 with a unit eigenvector, so its row and column of `out` are 0 and the other rows
+/// are inverted on their own, which usually takes the fast path below instead of the eigen
+/// decomposition. Levels of more than 64 rows are inverted whole.
+pub(crate) fn damped_inverse(
+    a: &mut [f64],
+    v: &mut [f64],
+    w: &mut [f64],
+    out: &mut [f64],
+    m: usize,
+    params: &InverseParams,
+) -> InverseInfo {
+    let zero = if m <= 64 { zero_rows(a, m) } else { 0 };
+    if zero == 0 {
+        return damped_inverse_full(a, v, w, out, m, params);
+    }
+    let kept = m - zero.count_ones() as usize;
+    compact(a, m, zero);
+    let info = if kept == 0 { InverseInfo::default() } else { damped_inverse_full(a, v, w, out, kept, params) };
+    expand(out, m, kept, zero);
+    info
+}
+
+/// Bit i set: row i of the symmetric `a` (m × m, m ≤ 64) is exactly zero.
+fn zero_rows(a: &[f64], m: usize) -> u64 {
+    a[..m * m].chunks_exact(m).enumerate().filter(|(_, col)| col.iter().all(|&x| x == 0.0)).fold(0, |z, (i, _)| z | 1 << i)
+}
+
+/// Moves the rows and columns of `a` (m × m) that are not in `zero` to the front, as a
+/// kept × kept matrix (in place: every entry moves to a lower index, in increasing order).
+fn compact(a: &mut [f64], m: usize, zero: u64) {
+    let mut d = 0;
+    for c in (0..m).filter(|c| zero >> c & 1 == 0) {
+        for r in (0..m).filter(|r| zero >> r & 1 == 0) {
+            a[d] = a[c * m + r];
+            d += 1;
+        }
+    }
+}
+
+/// The inverse of [`compact`] for `out`: the kept × kept matrix at the front of `out` spread to
+/// m × m with zero rows and columns at `zero` (in place, from the back).
+fn expand(out: &mut [f64], m: usize, kept: usize, zero: u64) {
+    let below = |i: usize| i - (zero & ((1u64 << i) - 1)).count_ones() as usize;
+    for c in (0..m).rev() {
+        for r in (0..m).rev() {
+            let keep = zero >> c & 1 == 0 && zero >> r & 1 == 0;
+            out[c * m + r] = if keep { out[below(c) * kept + below(r)] } else { 0.0 };
+        }
+    }
+}
+
+/// [`damped_inverse`] without looking for zero rows.
+///
 /// Fast path first: a Cholesky inverse `A⁻¹`; if `1/‖A⁻¹‖_F` (a lower bound of the smallest
 /// eigenvalue) is above both the damping band and the rank threshold, every eigenvalue gets
 /// `f(e) = 1/e`, so `A⁻¹` *is* the filtered inverse and the eigen decomposition (the most
 /// expensive step) is skipped. Otherwise the eigen decomposition and the filter.
-pub(crate) fn damped_inverse(
+fn damped_inverse_full(
     a: &mut [f64],
     v: &mut [f64],
     w: &mut [f64],
@@ -499,7 +583,8 @@ mod tests {
             cholesky(m.as_slice(), &mut lp, n, ld).unwrap();
             crate::hierarchy::dense::unpad(&lp, &mut back, n, ld, n);
             assert_eq!(back, l, "n = {n}: padded factor");
-            spd_inverse_padded(&lp, &mut lip, &mut rows, &mut mp, n, ld);
+            spd_inverse_padded(&lp, &mut rows, &mut mp, n, ld);
+            lower_inverse_padded(&lp, &mut rows, &mut lip, n, ld);
             assert_eq!(lip, li, "n = {n}: L⁻¹");
             crate::hierarchy::dense::unpad(&mp, &mut back, n, ld, n);
             assert_eq!(back, mi, "n = {n}");
@@ -569,6 +654,55 @@ mod tests {
             let slow = &vm * f * vm.transpose();
             assert!((DMatrix::from_column_slice(m, m, &fast) - &slow).norm() < 1e-10 * slow.norm());
         }
+    }
+
+    #[test]
+    fn eigen_2x2_handles_the_edge_cases() {
+        // diagonal, rank one, equal diagonal, a coupling far below the diagonal's scale, and one far above
+        for [a00, a10, a11] in [[2.0, 0.0, 3.0], [1.0, 2.0, 4.0], [5.0, 1e-3, 5.0], [1.0, 1e-200, 2.0], [1e-9, 1e9, 0.0]] {
+            let a0 = DMatrix::from_column_slice(2, 2, &[a00, a10, a10, a11]);
+            let (mut a, mut v) = (a0.as_slice().to_vec(), vec![0.0; 4]);
+            symmetric_eigen(&mut a, &mut v, 2);
+            assert_eq!((a[1], a[2]), (0.0, 0.0));
+            let vm = DMatrix::from_column_slice(2, 2, &v);
+            let e = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![a[0], a[3]]));
+            assert!((&vm * e * vm.transpose() - &a0).norm() <= 1e-15 * a0.norm(), "{a0}");
+            assert!((vm.transpose() * &vm - DMatrix::identity(2, 2)).norm() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn zero_rows_are_split_off_and_get_zero_inverse() {
+        let p = InverseParams::default();
+        let inner = random_spd(3, 9);
+        // the 3 × 3 matrix spread over rows/columns 0, 2, 4 of a 5 × 5 one
+        let at = [0, 2, 4];
+        let a0 = DMatrix::from_fn(5, 5, |r, c| match (at.iter().position(|&i| i == r), at.iter().position(|&i| i == c)) {
+            (Some(i), Some(j)) => inner[(i, j)],
+            _ => 0.0,
+        });
+        let run = |split: bool| {
+            let (mut a, mut v, mut w, mut out) = (a0.as_slice().to_vec(), vec![0.0; 25], vec![0.0; 25], vec![7.0; 25]);
+            let info = if split { damped_inverse(&mut a, &mut v, &mut w, &mut out, 5, &p) } else { damped_inverse_full(&mut a, &mut v, &mut w, &mut out, 5, &p) };
+            (info, DMatrix::from_column_slice(5, 5, &out))
+        };
+        let ((info, split), (whole_info, whole)) = (run(true), run(false));
+        assert_eq!((info.rank, info.damped), (3, 0));
+        assert_eq!((whole_info.rank, whole_info.damped), (3, 0), "the eigen path agrees on the rank");
+        assert!((&split - &whole).norm() < 1e-10 * whole.norm(), "{split} vs {whole}");
+        for i in [1, 3] {
+            assert!(split.row(i).iter().chain(split.column(i).iter()).all(|&x| x == 0.0));
+        }
+        let inv = inner.try_inverse().unwrap();
+        for (i, &r) in at.iter().enumerate() {
+            for (j, &c) in at.iter().enumerate() {
+                assert!((split[(r, c)] - inv[(i, j)]).abs() < 1e-10 * inv.norm());
+            }
+        }
+        // nothing left: rank 0, all zero
+        let (mut a, mut v, mut w, mut out) = (vec![0.0; 9], vec![0.0; 9], vec![0.0; 9], vec![1.0; 9]);
+        assert_eq!(damped_inverse(&mut a, &mut v, &mut w, &mut out, 3, &p).rank, 0);
+        assert!(out.iter().all(|&x| x == 0.0));
     }
 
     #[test]

@@ -6,10 +6,10 @@ use nalgebra::{DMatrix, DVector};
 use crate::model::{bias_forces, crba, ModelData, RobotModel};
 
 use super::dense::{
-    add_mul_vec, axpy, dot, mul, mul_padded, mul_tn, mul_tr_vec, mul_vec, mul_vec2_padded, mul_vec_padded, sub_outer_mul_vec_padded, norm, pad, padded_len, set_identity_padded,
+    add_mul_vec, add_mul_vec_padded, axpy, dot, mul, mul_padded, mul_tn, mul_tr_vec, mul_vec, mul_vec2_padded, mul_vec_padded, sub_outer_mul_vec_padded, norm, pad, padded_len, set_identity_padded,
     sub_mul_nt, sub_outer_padded, unpad,
 };
-use super::inverse::{cholesky, damped_inverse, spd_inverse_padded, symmetric_eigen, InverseParams};
+use super::inverse::{cholesky, damped_inverse, lower_inverse_padded, spd_inverse_padded, symmetric_eigen, InverseParams};
 use super::{HierarchyError, ReferenceKind, TaskLevel};
 
 /// What one level did in the last solve.
@@ -61,7 +61,8 @@ pub struct HierarchySolver {
     max_levels: usize,
     max_rows: usize,
     params: InverseParams,
-    /// `L` of `M = L Lᵀ` (also padded: `chol_pad`) and `L⁻¹`, n × n.
+    /// `L` of `M = L Lᵀ` (padded: `chol_pad`) and, for the levels that need them
+    /// ([`Self::wide_level`]), `L` and `L⁻¹` n × n.
     chol: Vec<f64>,
     chol_pad: Vec<f64>,
     linv: Vec<f64>,
@@ -86,11 +87,13 @@ pub struct HierarchySolver {
     /// max_rows: task-space residual and Λ̄ r.
     r: Vec<f64>,
     s: Vec<f64>,
-    /// n: Σ τ̄, τ̄_k, M⁻¹ Σ τ̄, N_L τ_c*, predicted q̈.
+    /// n: Σ τ̄, predicted q̈; padded (ld): τ̄_k, M⁻¹ Σ τ̄, N_L τ_c*.
     tau_sum: Vec<f64>,
     tau_bar: Vec<f64>,
     u_sum: Vec<f64>,
     posture_proj: Vec<f64>,
+    /// n: `J_kᵀ F_k` of an activated level, before its projection.
+    force_torque: Vec<f64>,
     qdd: DVector<f64>,
     diagnostics: Vec<LevelDiagnostics>,
     /// M and C q̇ + g for [`HierarchySolver::solve_model`].
@@ -128,9 +131,10 @@ impl HierarchySolver {
             r: vec![0.0; m],
             s: vec![0.0; m],
             tau_sum: vec![0.0; n],
-            tau_bar: vec![0.0; n],
-            u_sum: vec![0.0; n],
+            tau_bar: vec![0.0; ld],
+            u_sum: vec![0.0; ld],
             posture_proj: vec![0.0; ld],
+            force_torque: vec![0.0; n],
             qdd: DVector::zeros(n),
             diagnostics: Vec::with_capacity(max_levels),
             m_model: DMatrix::zeros(n, n),
@@ -210,8 +214,7 @@ impl HierarchySolver {
         let levels = levels.into_iter();
 
         cholesky(mass_matrix.as_slice(), &mut self.chol_pad, n, ld)?;
-        unpad(&self.chol_pad, &mut self.chol, n, ld, n);
-        spd_inverse_padded(&self.chol_pad, &mut self.linv, &mut self.z, &mut self.minv_pad, n, ld);
+        spd_inverse_padded(&self.chol_pad, &mut self.z, &mut self.minv_pad, n, ld);
         unpad(&self.minv_pad, self.minv.as_mut_slice(), n, ld, n);
         set_identity_padded(&mut self.nproj_pad, n, ld);
         self.tau_sum.fill(0.0);
@@ -227,6 +230,12 @@ impl HierarchySolver {
                 self.diagnostics.push(diag);
                 continue;
             }
+            if level.is_activated() {
+                // skin rows with activations: weighted, row by row (any m)
+                self.activated_level(k, level, &mut diag, &mut first)?;
+                self.diagnostics.push(diag);
+                continue;
+            }
             let (nm, mm) = (n * m, m * m);
             let jt = level.jt_slice();
             // J̄_kᵀ = N_{k−1} J_kᵀ (eq. 22)
@@ -235,12 +244,6 @@ impl HierarchySolver {
             } else {
                 mul_padded(&self.nproj_pad, jt, &mut self.z, ld, n, m);
                 unpad(&self.z, &mut self.jbt, n, ld, m);
-            }
-            if level.is_activated() {
-                // skin rows with activations: weighted, row by row (any m)
-                self.activated_level(k, level, &mut diag, &mut first)?;
-                self.diagnostics.push(diag);
-                continue;
             }
             if m > n {
                 // more rows than joints (stacked skin cells): the same level in joint space
@@ -279,7 +282,7 @@ impl HierarchySolver {
             }
             // τ̄_k = J̄_kᵀ s (eq. 20); M⁻¹ τ̄_k = Y s
             mul_vec(&self.jbt[..nm], &self.s[..m], &mut self.tau_bar, n, m);
-            axpy(1.0, &self.tau_bar, &mut self.tau_sum);
+            axpy(1.0, &self.tau_bar[..n], &mut self.tau_sum);
             add_mul_vec(&self.y[..nm], &self.s[..m], &mut self.u_sum, n, m);
             diag.torque_norm = norm(&self.tau_bar);
             if !self.tau_sum.iter().all(|t| t.is_finite()) {
@@ -305,10 +308,10 @@ impl HierarchySolver {
         unpad(&self.nproj_pad, self.nproj.as_mut_slice(), n, ld, n);
         if let Some(tc) = posture {
             mul_vec_padded(&self.nproj_pad, tc, &mut self.posture_proj, ld, n);
-            axpy(1.0, &self.posture_proj, &mut self.tau_sum);
-            add_mul_vec(self.minv.as_slice(), &self.posture_proj, &mut self.u_sum, n, n);
+            axpy(1.0, &self.posture_proj[..n], &mut self.tau_sum);
+            add_mul_vec_padded(&self.minv_pad, &self.posture_proj, &mut self.u_sum, ld, n);
         }
-        self.qdd.as_mut_slice().copy_from_slice(&self.u_sum);
+        self.qdd.as_mut_slice().copy_from_slice(&self.u_sum[..n]);
         for (k, level) in levels.enumerate() {
             if level.kind() == ReferenceKind::Acceleration && level.rows() > 0 {
                 let mut e2 = 0.0;
@@ -341,8 +344,10 @@ impl HierarchySolver {
     ///
     /// Cost `m n² + O(n³)` instead of `O(m³)`: 50 active cells on one level stay cheap.
     fn wide_level(&mut self, k: usize, level: &TaskLevel, diag: &mut LevelDiagnostics, first: &mut bool) -> Result<(), HierarchyError> {
-        let (n, m) = (self.nv, level.rows());
+        let (n, m, ld) = (self.nv, level.rows(), padded_len(self.nv));
         let (nm, nn) = (n * m, n * n);
+        unpad(&self.chol_pad, &mut self.chol, n, ld, n);
+        lower_inverse_padded(&self.chol_pad, &mut self.z, &mut self.linv, n, ld);
         // C = L⁻¹ (J̄ᵀ J̄) L⁻ᵀ, symmetrized; its eigen decomposition
         self.w[..nn].fill(0.0);
         sub_mul_nt(&mut self.w[..nn], &self.jbt[..nm], &self.jbt[..nm], n, m, n);
@@ -373,7 +378,6 @@ impl HierarchySolver {
             }
         }
         diag.rows = m;
-        let (f, ef) = (&self.r[..n], &self.s[..n]);
 
         // τ̄_k: force level J̄ᵀ F; acceleration level L V f Vᵀ L⁻¹ J̄ᵀ (ẍ* − J̇q̇ − a_k)
         match level.kind() {
@@ -389,30 +393,24 @@ impl HierarchySolver {
                 mul_vec(&self.jbt[..nm], res, g, n, m);
                 mul_vec(&self.linv, g, h, n, n);
                 mul_tr_vec(&self.v[..nn], h, &mut p[..n], n, n);
-                for (pi, fi) in p[..n].iter_mut().zip(f) {
+                for (pi, fi) in p[..n].iter_mut().zip(&self.r[..n]) {
                     *pi *= fi;
                 }
                 mul_vec(&self.v[..nn], &p[..n], g, n, n);
                 mul_vec(&self.chol, g, &mut self.tau_bar, n, n);
             }
         }
-        axpy(1.0, &self.tau_bar, &mut self.tau_sum);
-        add_mul_vec(self.minv.as_slice(), &self.tau_bar, &mut self.u_sum, n, n);
-        diag.torque_norm = norm(&self.tau_bar);
-        if !self.tau_sum.iter().all(|t| t.is_finite()) {
-            return Err(HierarchyError::Overflow { level: k });
-        }
+        self.add_level_torque(k, diag)?;
 
         // N_k = N_{k−1} − (N_{k−1} L V) (L⁻ᵀ V diag(e f))ᵀ
         if diag.rank > 0 {
             mul(&self.chol, &self.v[..nn], &mut self.w[..nn], n, n, n);
             mul_tn(&self.linv, &self.v[..nn], &mut self.lam[..nn], n, n, n);
-            for (col, s) in self.lam[..nn].chunks_exact_mut(n).zip(ef) {
+            for (col, s) in self.lam[..nn].chunks_exact_mut(n).zip(&self.s[..n]) {
                 for x in col {
                     *x *= s;
                 }
             }
-            let ld = padded_len(n);
             if *first {
                 pad(&self.w, &mut self.z, n, ld, n);
             } else {
@@ -424,8 +422,7 @@ impl HierarchySolver {
         Ok(())
     }
 
-    /// A force level of activated rows (J̄ᵀ already in `jbt`): the torque is the usual
-    /// `τ̄_k = N_{k−1} J_kᵀ F_k`; the projector takes the rows one at a time, each weighted by its
+    /// A force level of activated rows: the torque is the usual `τ̄_k = N_{k−1} (J_kᵀ F_k)`; the projector takes the rows one at a time, each weighted by its
     /// activation `a_i` (continuous null-space projection, Dietrich et al. 2012):
     ///
     /// ```text
@@ -439,15 +436,28 @@ impl HierarchySolver {
     /// M-metric each factor has eigenvalues `1` and `1 − a_i e_i f(e_i) ∈ [0, 1]`).
     fn activated_level(&mut self, k: usize, level: &TaskLevel, diag: &mut LevelDiagnostics, first: &mut bool) -> Result<(), HierarchyError> {
         let (n, m) = (self.nv, level.rows());
-        mul_vec(&self.jbt[..n * m], level.target(), &mut self.tau_bar, n, m);
-        axpy(1.0, &self.tau_bar, &mut self.tau_sum);
-        add_mul_vec(self.minv.as_slice(), &self.tau_bar, &mut self.u_sum, n, n);
+        if *first {
+            mul_vec(level.jt_slice(), level.target(), &mut self.tau_bar, n, m);
+        } else {
+            mul_vec(level.jt_slice(), level.target(), &mut self.force_torque, n, m);
+            mul_vec_padded(&self.nproj_pad, &self.force_torque, &mut self.tau_bar, padded_len(n), n);
+        }
         diag.rows = m;
+        self.add_level_torque(k, diag)?;
+        self.project_activated_rows(level, diag, first);
+        Ok(())
+    }
+
+    /// Adds the level torque `τ̄_k` (in `tau_bar`) to `Σ τ̄` and `M⁻¹ τ̄_k` to `M⁻¹ Σ τ̄`; its norm
+    /// into the diagnostics. Fails if the sum overflows.
+    fn add_level_torque(&mut self, k: usize, diag: &mut LevelDiagnostics) -> Result<(), HierarchyError> {
+        let (n, ld) = (self.nv, padded_len(self.nv));
+        axpy(1.0, &self.tau_bar[..n], &mut self.tau_sum);
+        add_mul_vec_padded(&self.minv_pad, &self.tau_bar, &mut self.u_sum, ld, n);
         diag.torque_norm = norm(&self.tau_bar);
         if !self.tau_sum.iter().all(|t| t.is_finite()) {
             return Err(HierarchyError::Overflow { level: k });
         }
-        self.project_activated_rows(level, diag, first);
         Ok(())
     }
 

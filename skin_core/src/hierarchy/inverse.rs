@@ -495,10 +495,11 @@ fn expand(out: &mut [f64], m: usize, kept: usize, zero: u64) {
 
 /// [`damped_inverse`] without looking for zero rows.
 ///
-/// Fast path first: a Cholesky inverse `A⁻¹`; if `1/‖A⁻¹‖_F` (a lower bound of the smallest
-/// eigenvalue) is above both the damping band and the rank threshold, every eigenvalue gets
-/// `f(e) = 1/e`, so `A⁻¹` *is* the filtered inverse and the eigen decomposition (the most
-/// expensive step) is skipped. Otherwise the eigen decomposition and the filter.
+/// Fast path first (m > 2): a Cholesky inverse `A⁻¹`; if `1/‖A⁻¹‖_F` (a lower bound of the
+/// smallest eigenvalue) is above both the damping band and the rank threshold, every eigenvalue
+/// gets `f(e) = 1/e`, so `A⁻¹` *is* the filtered inverse and the eigen decomposition (the most
+/// expensive step) is skipped. Otherwise the eigen decomposition and the filter; for m ≤ 2 it is
+/// closed-form and cheaper than the Cholesky inverse, so it is taken directly.
 fn damped_inverse_full(
     a: &mut [f64],
     v: &mut [f64],
@@ -508,7 +509,7 @@ fn damped_inverse_full(
     params: &InverseParams,
 ) -> InverseInfo {
     let trace: f64 = (0..m).map(|i| a[i * m + i]).sum();
-    if trace > 0.0 && cholesky(a, v, m, m).is_ok() {
+    if m > 2 && trace > 0.0 && cholesky(a, v, m, m).is_ok() {
         spd_inverse_from_cholesky(v, w, out, m);
         let e_min_bound = 1.0 / super::dense::norm(&out[..m * m]);
         // e_max ≤ trace bounds the relative threshold from above

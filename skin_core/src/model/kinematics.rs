@@ -184,9 +184,12 @@ pub fn point_jacobian(
 
 /// The row `dᵀ J_v` of the point `point_in_frame` of frame `frame`: the linear rows of
 /// [`point_jacobian`] along the world direction `d`, into `out` (length nv), without forming the
-/// 6 × nv Jacobian (one skin cell's force row, paper 000 eq. 4 and 6). Each entry is summed as
-/// [`crate::hierarchy::TaskLevel::push_directional`] sums `dᵀ J_v`, so the row is the same to
-/// the bit.
+/// 6 × nv Jacobian (one skin cell's force row, paper 000 eq. 4 and 6).
+///
+/// Entry j is the power of the unit force `d` at the point through joint j's motion subspace,
+/// `s_jᵀ [r × d; d]` with `r` the point about the reference point (the force as a spatial
+/// force, RBDA Sec. 2.8): one 6-vector dot product per joint of the chain, for revolute and
+/// prismatic joints alike (equal to `dᵀ (a_j × (p − o_j))` and `dᵀ a_j` up to rounding).
 pub fn point_jacobian_along(
     model: &RobotModel,
     data: &ModelData,
@@ -199,20 +202,13 @@ pub fn point_jacobian_along(
     if out.len() != model.nv() {
         return Err(ModelError::Dimension { what: "jacobian row length", expected: model.nv(), got: out.len() });
     }
-    let p = (data.frame_pose[frame] * Point3::from(*point_in_frame)).coords;
-    let along = |l: [f64; 3]| -> f64 { direction.iter().zip(l).map(|(d, l)| d * l).sum() };
-    // joints that do not move the frame: a zero column (dᵀ 0, its zero signed as the sum gives it)
-    out.fill(along([0.0; 3]));
+    let r = (data.frame_pose[frame] * Point3::from(*point_in_frame)).coords - data.ref_point;
+    let force = svec(&r.cross(direction), direction);
+    // joints that do not move the frame: a zero column
+    out.fill(0.0);
     let mut k = model.frames[frame].body;
     while let Some(j) = k {
-        let a = &data.axis_w[j];
-        out[j] = match model.bodies[j].kind {
-            JointKind::Revolute => {
-                let l = a.cross(&(p - data.body_pos[j]));
-                along([l[0], l[1], l[2]])
-            }
-            JointKind::Prismatic => along([a[0], a[1], a[2]]),
-        };
+        out[j] = data.s[j].dot(&force);
         k = model.bodies[j].parent;
     }
     Ok(())

@@ -595,7 +595,7 @@ fn activated_case(s: &State, a: [f64; 2]) -> (DVector<f64>, DMatrix<f64>) {
     let mut solver = HierarchySolver::new(n, 2, 2, InverseParams::default()).unwrap();
     let mut tau = DVector::zeros(n);
     solver.solve(&s.m, [&skin, &goal], None, None, &mut tau).unwrap();
-    (tau, solver.null_space().clone())
+    (tau, solver.null_space())
 }
 
 #[test]
@@ -623,7 +623,7 @@ fn hierarchy_activated_rows_are_exact_at_the_ends_and_continuous_between() {
         let mut solver = HierarchySolver::new(n, 1, 2, InverseParams::default()).unwrap();
         let mut tau = DVector::zeros(n);
         solver.solve(&s.m, [&skin], None, None, &mut tau).unwrap();
-        (tau, solver.null_space().clone())
+        (tau, solver.null_space())
     };
     let (t_skin, n_half) = skin_only([1.0, 0.0]);
     let mut one = TaskLevel::new("avoidance", n, 2);

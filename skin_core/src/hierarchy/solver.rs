@@ -66,9 +66,6 @@ pub struct HierarchySolver {
     chol: Vec<f64>,
     chol_pad: Vec<f64>,
     linv: Vec<f64>,
-    minv: DMatrix<f64>,
-    /// N_L of the last solve (copied from `nproj_pad`).
-    nproj: DMatrix<f64>,
     /// `M⁻¹` and N_{k−1} (during the pass) with padded columns (`dense::padded_len`), so that
     /// the products with them run without remainder loops.
     minv_pad: Vec<f64>,
@@ -118,8 +115,6 @@ impl HierarchySolver {
             chol: vec![0.0; n * n],
             chol_pad: vec![0.0; ld * n],
             linv: vec![0.0; n * n],
-            minv: DMatrix::zeros(n, n),
-            nproj: DMatrix::identity(n, n),
             jbt: vec![0.0; n * m],
             y: vec![0.0; n * m],
             z: vec![0.0; ld * m.max(n)],
@@ -169,14 +164,23 @@ impl HierarchySolver {
         &self.diagnostics
     }
 
-    /// `M⁻¹` of the last successful solve.
-    pub fn mass_inverse(&self) -> &DMatrix<f64> {
-        &self.minv
+    /// `M⁻¹` of the last solve (a copy: for tests and diagnostics, the cycle does not need it
+    /// unpadded).
+    pub fn mass_inverse(&self) -> DMatrix<f64> {
+        self.unpadded(&self.minv_pad)
     }
 
-    /// The null-space projector `N_L` of the last successful solve (eq. 24 after the last level).
-    pub fn null_space(&self) -> &DMatrix<f64> {
-        &self.nproj
+    /// The null-space projector `N_L` of the last solve (eq. 24 after the last level; after an
+    /// error, after the levels processed before it). A copy, like [`Self::mass_inverse`].
+    pub fn null_space(&self) -> DMatrix<f64> {
+        self.unpadded(&self.nproj_pad)
+    }
+
+    fn unpadded(&self, padded: &[f64]) -> DMatrix<f64> {
+        let n = self.nv;
+        let mut m = DMatrix::zeros(n, n);
+        unpad(padded, m.as_mut_slice(), n, padded_len(n), n);
+        m
     }
 
     /// Model-predicted acceleration of the last successful solve, `M⁻¹ (Σ τ̄_k + N_L τ_c*)`, i.e. `q̈` when
@@ -215,7 +219,6 @@ impl HierarchySolver {
 
         cholesky(mass_matrix.as_slice(), &mut self.chol_pad, n, ld)?;
         spd_inverse_padded(&self.chol_pad, &mut self.z, &mut self.minv_pad, n, ld);
-        unpad(&self.minv_pad, self.minv.as_mut_slice(), n, ld, n);
         set_identity_padded(&mut self.nproj_pad, n, ld);
         self.tau_sum.fill(0.0);
         self.u_sum.fill(0.0);
@@ -305,7 +308,6 @@ impl HierarchySolver {
 
         // N_L τ_c* (eq. 19) and the predicted acceleration
         let nlevels = self.diagnostics.len();
-        unpad(&self.nproj_pad, self.nproj.as_mut_slice(), n, ld, n);
         if let Some(tc) = posture {
             mul_vec_padded(&self.nproj_pad, tc, &mut self.posture_proj, ld, n);
             axpy(1.0, &self.posture_proj[..n], &mut self.tau_sum);

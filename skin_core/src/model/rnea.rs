@@ -14,8 +14,8 @@ fn check_out(model: &RobotModel, out: &DVector<f64>) -> Result<(), ModelError> {
     Ok(())
 }
 
-/// Shared RNEA core. `qdd = None` means q̈ = 0; `with_velocity = false` treats q̇ as zero.
-fn rnea_impl(model: &RobotModel, data: &mut ModelData, qdd: Option<&[f64]>, with_velocity: bool, tau: &mut DVector<f64>) {
+/// Shared RNEA core. `qdd = None` means q̈ = 0.
+fn rnea_impl(model: &RobotModel, data: &mut ModelData, qdd: Option<&[f64]>, tau: &mut DVector<f64>) {
     // Gravity enters as a fictitious upward acceleration of the base (RBDA Sec. 5.3).
     let a0 = svec(&Vector3::zeros(), &(-model.gravity));
     let n = model.nv();
@@ -30,17 +30,18 @@ fn rnea_impl(model: &RobotModel, data: &mut ModelData, qdd: Option<&[f64]>, with
             a += data.s[i] * qdd[i];
         }
         let inertia = &data.inertia_w[i];
-        let f = if with_velocity {
-            a += data.c[i];
-            let v = &data.v[i];
-            inertia.mul_motion(&a) + cross_force(v, &inertia.mul_motion(v))
-        } else {
-            inertia.mul_motion(&a)
-        };
+        a += data.c[i];
+        let v = &data.v[i];
+        let f = inertia.mul_motion(&a) + cross_force(v, &inertia.mul_motion(v));
         data.a[i] = a;
         data.f[i] = f;
     }
-    for i in (0..n).rev() {
+    backward_pass(model, data, tau);
+}
+
+/// RNEA's second pass: `τ_i = S_iᵀ f_i`, each body's force added to its parent's.
+fn backward_pass(model: &RobotModel, data: &mut ModelData, tau: &mut DVector<f64>) {
+    for i in (0..model.nv()).rev() {
         let f: SVec = data.f[i];
         tau[i] = data.s[i].dot(&f);
         if let Some(p) = model.bodies[i].parent {
@@ -58,20 +59,26 @@ fn rnea_impl(model: &RobotModel, data: &mut ModelData, qdd: Option<&[f64]>, with
 pub fn rnea(model: &RobotModel, data: &mut ModelData, qdd: &[f64], tau_out: &mut DVector<f64>) -> Result<(), ModelError> {
     check_vector(model, "qdd", qdd)?;
     check_out(model, tau_out)?;
-    rnea_impl(model, data, Some(qdd), true, tau_out);
+    rnea_impl(model, data, Some(qdd), tau_out);
     Ok(())
 }
 
 /// Bias forces `C(q, q̇) q̇ + g(q)` (= [`rnea`] with q̈ = 0).
 pub fn bias_forces(model: &RobotModel, data: &mut ModelData, out: &mut DVector<f64>) -> Result<(), ModelError> {
     check_out(model, out)?;
-    rnea_impl(model, data, None, true, out);
+    rnea_impl(model, data, None, out);
     Ok(())
 }
 
-/// Gravity torques `g(q)` (q̇ treated as zero, q̈ = 0).
+/// Gravity torques `g(q)` (q̇ treated as zero, q̈ = 0): [`rnea`] with every body at the base's
+/// fictitious acceleration `a_0 = [0; −g]`, whose force `I_i a_0 = [h_i × (−g); −m_i g]`
+/// (`h_i` the body's first mass moment about the reference point) needs no inertia product.
 pub fn gravity(model: &RobotModel, data: &mut ModelData, out: &mut DVector<f64>) -> Result<(), ModelError> {
     check_out(model, out)?;
-    rnea_impl(model, data, None, false, out);
+    let a0 = -model.gravity;
+    for (f, inertia) in data.f.iter_mut().zip(&data.inertia_w) {
+        *f = svec(&inertia.h.cross(&a0), &(a0 * inertia.mass));
+    }
+    backward_pass(model, data, out);
     Ok(())
 }

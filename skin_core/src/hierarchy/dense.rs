@@ -90,8 +90,8 @@ pub(crate) const BLOCK: usize = 8;
 macro_rules! with_const_ld {
     ($ld:ident, $body:block) => {
         match $ld {
-            BLOCK => {
-                let $ld = BLOCK;
+            $crate::hierarchy::dense::BLOCK => {
+                let $ld = $crate::hierarchy::dense::BLOCK;
                 $body
             }
             16 => {

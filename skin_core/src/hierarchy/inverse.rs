@@ -106,6 +106,11 @@ avx2_dispatch! {
 
 #[inline(always)]
 fn cholesky_kernel(m: &[f64], l: &mut [f64], n: usize, ld: usize) -> Result<(), HierarchyError> {
+    with_const_ld!(ld, { cholesky_columns(m, l, n, ld) })
+}
+
+#[inline(always)]
+fn cholesky_columns(m: &[f64], l: &mut [f64], n: usize, ld: usize) -> Result<(), HierarchyError> {
     super::dense::pad(m, l, n, ld, n);
     for k in 0..n {
         let (done, later) = l[..ld * n].split_at_mut((k + 1) * ld);
@@ -164,6 +169,11 @@ pub(crate) fn lower_inverse_padded(l: &[f64], rows: &mut [f64], linv: &mut [f64]
 
 #[inline(always)]
 fn spd_inverse_padded_kernel(l: &[f64], rows: &mut [f64], minv: &mut [f64], n: usize, ld: usize) {
+    with_const_ld!(ld, { spd_inverse_columns(l, rows, minv, n, ld) })
+}
+
+#[inline(always)]
+fn spd_inverse_columns(l: &[f64], rows: &mut [f64], minv: &mut [f64], n: usize, ld: usize) {
     lower_inverse_rows(l, ld, rows, n, ld);
     // −M⁻¹ = −Σ_k r_k r_kᵀ (the columns j ≤ k that r_k reaches), then negated: exact
     minv[..ld * n].fill(0.0);

@@ -28,6 +28,7 @@
 //! assert!(((&j * qdd)[0] - 0.1).abs() < 1e-12);
 //! ```
 
+#[macro_use]
 mod dense;
 mod error;
 mod inverse;

@@ -120,7 +120,7 @@ fn skin_cycle_does_not_allocate_after_setup() {
     let mut cycle = |data: &mut ModelData| {
         update_kinematics(&model, data, &q, &qd).unwrap();
         aggregate_patches(&layout, &readings, &params.fusion, &mut wrenches).unwrap();
-        patch_poses_world(&layout, |f| data.frame_pose(f), &mut poses);
+        patch_poses_world(&layout, |f| data.frame_pose(f), |_| true, &mut poses);
         let h = sum_patch_forces_in_frame(data.frame_pose(hand), &poses, &wrenches, |j| j < 6);
         let w = patch_wrench_world(&poses[0], &wrenches[0]);
         patch_wrenches_to_torques(&model, data, &layout, &wrenches, |_| true, &mut tau);
@@ -354,7 +354,7 @@ fn tasks_do_not_allocate_after_setup() {
         update_kinematics(&model, data, &q, &qd).unwrap();
         live.collect(&readings);
         aggregate_live_patches(&layout, &live, &skin.fusion, &mut wrenches).unwrap();
-        patch_poses_world(&layout, |f| data.frame_pose(f), &mut poses);
+        patch_poses_world(&layout, |f| data.frame_pose(f), |_| true, &mut poses);
         let h_f = sum_patch_forces_in_frame(data.frame_pose(hand), &poses, &wrenches, |j| j < 6);
         let gamma = patch_wrench_world(&poses[5], &wrenches[5]).moment;
         let [l0, l1, l2, l3, l4, l5, l6, l7] = &mut levels;

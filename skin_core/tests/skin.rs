@@ -290,7 +290,7 @@ fn patch_torques_match_virtual_work() {
     patch_wrenches_to_torques(&model, &data, &layout, &wrenches, |_| true, &mut tau);
 
     let mut poses = Vec::new();
-    patch_poses_world(&layout, |f| data.frame_pose(f), &mut poses);
+    patch_poses_world(&layout, |f| data.frame_pose(f), |_| true, &mut poses);
     let h = 1e-6;
     let mut fd = DVector::zeros(model.nv());
     let mut scratch = ModelData::new(&model);

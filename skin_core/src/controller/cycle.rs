@@ -62,6 +62,7 @@ pub struct Controller {
     /// and the aggregation).
     live: LiveCells,
     wrenches: Vec<PatchWrench>,
+    /// World poses of the hand and guidance patches (the others are not kept up to date).
     patch_poses: Vec<Isometry3<f64>>,
     ee_jacobian: Matrix6xX<f64>,
     tau_k: DVector<f64>,
@@ -334,7 +335,9 @@ impl Controller {
         let layout = &self.config.layout;
         aggregate_live_patches(layout, &self.live, &self.fusion, &mut self.wrenches).map_err(stage("skin aggregation"))?;
         let data = &self.data;
-        patch_poses_world(layout, |f| data.frame_pose(f), &mut self.patch_poses);
+        // the hand signals read the hand and guidance patches' poses only
+        let (hand, guidance) = (&self.hand_patches, &self.guidance_patches);
+        patch_poses_world(layout, |f| data.frame_pose(f), |j| hand[j] || guidance[j], &mut self.patch_poses);
 
         // 3. tasks in priority order, posture, hierarchy
         let cx = CycleContext {

@@ -15,17 +15,21 @@ pub struct Wrench {
     pub moment: Vector3<f64>,
 }
 
-/// World poses of all patch frames, `w_T_p = w_T_link * link_T_p`, into `out` (indexed like
-/// `layout.patches()`; resized, allocating only when its capacity is too small).
-/// `frame_pose(frame)` gives a link's world pose (kinematics already updated).
+/// World poses of the patch frames `wanted(j)` selects, `w_T_p = w_T_link * link_T_p`, into
+/// `out` (indexed like `layout.patches()`, the other entries left as they are; resized,
+/// allocating only when its capacity is too small). `frame_pose(frame)` gives a link's world
+/// pose (kinematics already updated).
 pub fn patch_poses_world<'a>(
     layout: &ResolvedLayout,
     frame_pose: impl Fn(usize) -> &'a Isometry3<f64>,
+    wanted: impl Fn(usize) -> bool,
     out: &mut Vec<Isometry3<f64>>,
 ) {
     out.resize(layout.patches().len(), Isometry3::identity());
-    for (pose, patch) in out.iter_mut().zip(layout.patches()) {
-        *pose = frame_pose(patch.frame) * patch.link_from_patch;
+    for (j, (pose, patch)) in out.iter_mut().zip(layout.patches()).enumerate() {
+        if wanted(j) {
+            *pose = frame_pose(patch.frame) * patch.link_from_patch;
+        }
     }
 }
 
@@ -99,7 +103,7 @@ mod tests {
             ),
         ];
         let mut poses = Vec::new();
-        patch_poses_world(&l, |f| &frames[f], &mut poses);
+        patch_poses_world(&l, |f| &frames[f], |_| true, &mut poses);
         assert_relative_eq!(poses[0].translation.vector, Vector3::new(0.3, 0.0, 0.0));
         let w = |x: f64, y: f64, z: f64| PatchWrench {
             force: Vector3::new(x, y, z),

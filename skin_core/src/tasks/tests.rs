@@ -250,7 +250,7 @@ fn tactile_guidance_hand_follows_forearm_push() {
     let mut wrenches: Vec<PatchWrench> = Vec::new();
     aggregate_patches(&s.layout, &readings, &s.skin.fusion, &mut wrenches).unwrap();
     let mut poses = Vec::new();
-    patch_poses_world(&s.layout, |f| s.data.frame_pose(f), &mut poses);
+    patch_poses_world(&s.layout, |f| s.data.frame_pose(f), |_| true, &mut poses);
     let h_f = sum_patch_forces_in_frame(s.data.frame_pose(hand), &poses, &wrenches, |j| j == forearm);
     // the pushing object moves into the arm: along the cell's inward normal
     let cell = &s.layout.cells()[c];

@@ -1,12 +1,12 @@
 //! [`Controller`]: one control cycle from measurements to velocity commands.
 
-use nalgebra::{DMatrix, DVector, Isometry3, Matrix6xX};
+use nalgebra::{DMatrix, DVector, Isometry3};
 
 use super::io::{ControllerInput, ControllerOutput, Fault};
 use super::setup::{ControllerConfig, HierarchyDynamics, SetupError};
 use super::task_set::{CycleContext, HandSignals, TaskSet};
 use crate::hierarchy::{HierarchySolver, LevelDiagnostics};
-use crate::model::{gravity, point_jacobian, update_kinematics, ModelData};
+use crate::model::{gravity, point_velocity, update_kinematics, ModelData};
 use crate::resolver::{Commands, Resolver};
 use crate::skin::aggregate::{aggregate_live_patches, FusionParams, PatchWrench};
 use crate::skin::live::LiveCells;
@@ -14,7 +14,6 @@ use crate::skin::transforms::{patch_poses_world, patch_wrench_world, sum_patch_f
 use crate::supervisor::blend::chi;
 use crate::supervisor::{Arrangement, Imposed, Phase, PhaseRefused, Supervisor, SupervisorInput, TorqueBlender};
 use crate::tasks::posture::BaseReference;
-use crate::tasks::rows_times_qd;
 
 /// Maps a stage's error to [`Fault::Stage`] (the error's text would allocate).
 fn stage<E>(name: &'static str) -> impl FnOnce(E) -> Fault {
@@ -64,7 +63,6 @@ pub struct Controller {
     wrenches: Vec<PatchWrench>,
     /// World poses of the hand and guidance patches (the others are not kept up to date).
     patch_poses: Vec<Isometry3<f64>>,
-    ee_jacobian: Matrix6xX<f64>,
     tau_k: DVector<f64>,
     tau: DVector<f64>,
     gravity: DVector<f64>,
@@ -132,7 +130,6 @@ impl Controller {
             live: LiveCells::with_capacity(config.layout.num_cells(), &config.skin.proximity),
             wrenches: Vec::with_capacity(config.layout.patches().len()),
             patch_poses: Vec::with_capacity(config.layout.patches().len()),
-            ee_jacobian: Matrix6xX::zeros(nv),
             tau_k: DVector::zeros(nv),
             tau: DVector::zeros(nv),
             gravity: DVector::zeros(nv),
@@ -320,7 +317,7 @@ impl Controller {
         update_kinematics(&self.config.model, &mut self.data, input.q, input.qd).map_err(stage("kinematics"))?;
 
         // 1. signals and arrangement
-        let signals = self.signals(input)?;
+        let signals = self.signals()?;
         self.output.signals = signals;
         self.supervisor.update(input.t_s, &signals);
         if first || self.supervisor.last_transition().is_some() {
@@ -407,15 +404,13 @@ impl Controller {
 
     /// The supervisor's inputs: `‖F_d‖` at the nominal range, the largest contact force, the
     /// end-effector speed and goal error (task summaries only: no rows are built here).
-    fn signals(&mut self, input: &ControllerInput) -> Result<SupervisorInput, Fault> {
+    fn signals(&self) -> Result<SupervisorInput, Fault> {
         let (model, data, config) = (&self.config.model, &self.data, &self.config);
         let (skin, layout) = (&config.skin, &config.layout);
         let nominal = config.supervisor.sensing_range.nominal_m;
         let avoid = self.tasks.avoidance.summarize(layout, &self.live, nominal).map_err(stage("avoidance"))?;
         let contact = self.tasks.contact.summarize(layout, &self.live, &skin.force, &skin.fusion).map_err(stage("contact reaction"))?;
-        point_jacobian(model, data, self.ee, &nalgebra::Vector3::zeros(), &mut self.ee_jacobian)
-            .map_err(stage("end-effector Jacobian"))?;
-        let speed = rows_times_qd(&self.ee_jacobian, 0, input.qd).norm();
+        let speed = point_velocity(model, data, self.ee, &nalgebra::Vector3::zeros()).map_err(stage("end-effector velocity"))?.norm();
         let goal_error = self.goal.as_ref().map_or(f64::NAN, |g| {
             (g.translation.vector - data.frame_pose(self.ee).translation.vector).norm()
         });

@@ -214,6 +214,19 @@ pub fn point_jacobian_along(
     Ok(())
 }
 
+/// Linear velocity (world axes) of the point `point_in_frame` of frame `frame`, `J_v q̇` without
+/// the Jacobian: `v_P = v_O + ω × r` from the frame's body velocity of the last
+/// [`update_kinematics`] (zero for a frame attached to the world).
+pub fn point_velocity(model: &RobotModel, data: &ModelData, frame: usize, point_in_frame: &Vector3<f64>) -> Result<Vector3<f64>, ModelError> {
+    check_point(model, frame, point_in_frame)?;
+    let Some(b) = model.frames[frame].body else {
+        return Ok(Vector3::zeros());
+    };
+    let r = (data.frame_pose[frame] * Point3::from(*point_in_frame)).coords - data.ref_point;
+    let v = &data.v[b];
+    Ok(lin(v) + ang(v).cross(&r))
+}
+
 /// `J̇ q̇` of the point `point_in_frame` of frame `frame` (linear first, then angular): the
 /// classical acceleration of the point (including the centripetal `ω × (ω × r)` term) and the
 /// angular acceleration of the frame when q̈ = 0. Matches pinocchio's

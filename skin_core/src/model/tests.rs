@@ -230,6 +230,20 @@ fn point_jacobian_matches_finite_differences() {
 }
 
 #[test]
+fn point_velocity_is_the_jacobian_times_qd() {
+    for model in [tomm(), planar7()] {
+        let mut d = ModelData::new(&model);
+        let (q, qd, _) = Rng(31).state(&model);
+        update_kinematics(&model, &mut d, &q, &qd).unwrap();
+        for (f, p) in probe_frames(&model) {
+            let expected = jac(&model, &d, f, &p).fixed_rows::<3>(0) * DVector::from_column_slice(&qd);
+            let v = point_velocity(&model, &d, f, &p).unwrap();
+            assert!((v - expected).norm() <= 1e-12 * expected.norm().max(1.0), "{} frame {f}: {v} vs {expected}", model.name());
+        }
+    }
+}
+
+#[test]
 fn point_jacobian_along_is_the_linear_rows_along_the_direction() {
     for model in [tomm(), planar7()] {
         let mut d = ModelData::new(&model);

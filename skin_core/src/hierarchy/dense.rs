@@ -28,6 +28,7 @@ pub(crate) fn mul_tn(a: &[f64], b: &[f64], c: &mut [f64], r: usize, q: usize, p:
 }
 
 /// `c (r × p) -= a (r × q) · bᵀ` with `b` (p × q).
+#[inline(always)]
 pub(crate) fn sub_mul_nt(c: &mut [f64], a: &[f64], b: &[f64], r: usize, q: usize, p: usize) {
     let b = &b[..p * q];
     for (j, cj) in c[..r * p].chunks_exact_mut(r).enumerate() {
@@ -254,6 +255,17 @@ fn sub_outer_mul_vec_pass<const G: usize>(a: &mut [f64], u: &[f64], v: &[f64], x
     for (g, acc) in acc.iter().enumerate() {
         y[(b0 + g) * BLOCK..(b0 + g + 1) * BLOCK].copy_from_slice(acc);
     }
+}
+
+avx2_dispatch! {
+    /// [`sub_mul_nt`] on padded `c` (ld × p) and `a` (ld × q): the same operations, the column
+    /// length a constant where it can be.
+    sub_mul_nt_padded => sub_mul_nt_padded_kernel(c: &mut [f64], a: &[f64], b: &[f64], ld: usize, q: usize, p: usize)
+}
+
+#[inline(always)]
+fn sub_mul_nt_padded_kernel(c: &mut [f64], a: &[f64], b: &[f64], ld: usize, q: usize, p: usize) {
+    with_const_ld!(ld, { sub_mul_nt(c, a, b, ld, q, p) });
 }
 
 avx2_dispatch! {

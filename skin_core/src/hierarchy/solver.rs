@@ -7,7 +7,7 @@ use crate::model::{bias_forces, crba, ModelData, RobotModel};
 
 use super::dense::{
     add_mul_vec, add_mul_vec_padded, axpy, dot, mul, mul_padded, mul_tn, mul_tr_vec, mul_vec, mul_vec2_padded, mul_vec_padded, sub_outer_mul_vec_padded, norm, pad, padded_len, set_identity_padded,
-    sub_mul_nt, sub_outer_padded, unpad,
+    sub_mul_nt, sub_mul_nt_padded, sub_outer_padded, unpad,
 };
 use super::inverse::{cholesky, damped_inverse, lower_inverse_padded, spd_inverse_padded, symmetric_eigen, InverseParams};
 use super::{HierarchyError, ReferenceKind, TaskLevel};
@@ -300,7 +300,7 @@ impl HierarchySolver {
                 } else {
                     mul_padded(&self.nproj_pad, &self.jbt[..nm], &mut self.z, ld, n, m);
                 }
-                sub_mul_nt(&mut self.nproj_pad, &self.z, &self.wt[..nm], ld, m, n);
+                sub_mul_nt_padded(&mut self.nproj_pad, &self.z, &self.wt[..nm], ld, m, n);
                 first = false;
             }
             self.diagnostics.push(diag);
@@ -418,7 +418,7 @@ impl HierarchySolver {
             } else {
                 mul_padded(&self.nproj_pad, &self.w[..nn], &mut self.z, ld, n, n);
             }
-            sub_mul_nt(&mut self.nproj_pad, &self.z, &self.lam[..nn], ld, n, n);
+            sub_mul_nt_padded(&mut self.nproj_pad, &self.z, &self.lam[..nn], ld, n, n);
             *first = false;
         }
         Ok(())

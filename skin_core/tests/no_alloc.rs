@@ -327,7 +327,7 @@ fn tasks_do_not_allocate_after_setup() {
     let mut goal = GoalPosition::new(nv, hand, Vector3::zeros(), p.goal);
     let mut orient = GoalOrientation::new(nv, hand, p.goal_orientation);
     let mut avoid = ProximityAvoidance::new(nv, p.avoidance);
-    let mut contact = ContactReaction::new(nv, p.contact_reaction);
+    let mut contact = ContactReaction::new(nv, p.contact_reaction, &skin.force);
     let mut hand_task = HandForce::new(nv, hand, p.hand_force);
     let mut wrist = CompliantWrist::new(nv, hand, p.wrist);
     let mut guide = TactileGuidance::new(nv, hand, p.tactile_guidance);
@@ -361,7 +361,7 @@ fn tasks_do_not_allocate_after_setup() {
         goal.update(&model, data, &goal_x, l0).unwrap();
         orient.update(&model, data, &goal_r, l1).unwrap();
         avoid.update(&model, data, &layout, &live, 0.08, l2).unwrap();
-        contact.update(&model, data, &layout, &live, &skin.force, &skin.fusion, l3).unwrap();
+        contact.update(&model, data, &layout, &live, &skin.fusion, l3).unwrap();
         hand_task.update(&model, data, HandMeasurement::Force { fused_signal: 0.1 }, &skin.proximity, l4).unwrap();
         wrist.update(&model, data, &gamma, l5).unwrap();
         guide.update(&model, data, &h_f, l6).unwrap();

@@ -409,7 +409,7 @@ impl Controller {
         let (skin, layout) = (&config.skin, &config.layout);
         let nominal = config.supervisor.sensing_range.nominal_m;
         let avoid = self.tasks.avoidance.summarize(layout, &self.live, nominal).map_err(stage("avoidance"))?;
-        let contact = self.tasks.contact.summarize(layout, &self.live, &skin.force, &skin.fusion).map_err(stage("contact reaction"))?;
+        let contact = self.tasks.contact.summarize(layout, &self.live, &skin.fusion).map_err(stage("contact reaction"))?;
         let speed = point_velocity(model, data, self.ee, &nalgebra::Vector3::zeros()).map_err(stage("end-effector velocity"))?.norm();
         let goal_error = self.goal.as_ref().map_or(f64::NAN, |g| {
             (g.translation.vector - data.frame_pose(self.ee).translation.vector).norm()

@@ -180,7 +180,7 @@ impl TaskSet {
             kinds,
             levels,
             avoidance: ProximityAvoidance::new(nv, p.avoidance),
-            contact: ContactReaction::new(nv, p.contact_reaction),
+            contact: ContactReaction::new(nv, p.contact_reaction, &config.skin.force),
             goal: GoalPosition::new(nv, ee, zero, p.goal),
             orientation: GoalOrientation::new(nv, ee, p.goal_orientation),
             hand: HandForce::new(nv, ee, p.hand_force),
@@ -211,7 +211,7 @@ impl TaskSet {
             }
             TaskKind::ContactReaction => {
                 let layout = &cx.config.layout;
-                self.contact.update(model, data, layout, cx.cells, &skin.force, &skin.fusion, level)?;
+                self.contact.update(model, data, layout, cx.cells, &skin.fusion, level)?;
             }
             TaskKind::Goal => {
                 if let Some(goal) = cx.goal {

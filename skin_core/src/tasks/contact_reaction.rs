@@ -14,7 +14,7 @@ use super::TaskError;
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::{FusionParams, LengthMismatch};
-use crate::skin::characteristic::ForceCharacteristic;
+use crate::skin::characteristic::{ForceCharacteristic, PreparedForce};
 use crate::skin::layout::{ResolvedCell, ResolvedLayout};
 use crate::skin::live::LiveCells;
 
@@ -23,6 +23,8 @@ use crate::skin::live::LiveCells;
 pub struct ContactReaction {
     /// Gain and saturation.
     pub params: ContactReactionParams,
+    /// The cells' force characteristic (signal to newtons), prepared once.
+    force: PreparedForce,
     /// Scratch: one cell's Jacobian row.
     row: Vec<f64>,
 }
@@ -39,9 +41,10 @@ pub struct ContactSummary {
 }
 
 impl ContactReaction {
-    /// The task for a model with `nv` joints; its level needs `layout.num_cells()` rows.
-    pub fn new(nv: usize, params: ContactReactionParams) -> Self {
-        Self { params, row: vec![0.0; nv] }
+    /// The task for a model with `nv` joints and cells with the force characteristic `force`;
+    /// its level needs `layout.num_cells()` rows.
+    pub fn new(nv: usize, params: ContactReactionParams, force: &ForceCharacteristic) -> Self {
+        Self { params, force: force.prepared(), row: vec![0.0; nv] }
     }
 
     /// Fills `level` (force rows) from the non-silent cells of this cycle's readings.
@@ -52,13 +55,12 @@ impl ContactReaction {
         data: &ModelData,
         layout: &ResolvedLayout,
         cells: &LiveCells,
-        force: &ForceCharacteristic,
         fusion: &FusionParams,
         level: &mut TaskLevel,
     ) -> Result<ContactSummary, TaskError> {
         level.clear();
         let row = &mut self.row;
-        self.params.contact_cells(layout, cells, force, fusion, |cell, fa| {
+        self.params.contact_cells(layout, cells, &self.force, fusion, |cell, fa| {
             push_inward_cell_row(model, data, cell, fa, row, level)
         })
     }
@@ -68,10 +70,9 @@ impl ContactReaction {
         &self,
         layout: &ResolvedLayout,
         cells: &LiveCells,
-        force: &ForceCharacteristic,
         fusion: &FusionParams,
     ) -> Result<ContactSummary, TaskError> {
-        self.params.contact_cells(layout, cells, force, fusion, |_, _| Ok(()))
+        self.params.contact_cells(layout, cells, &self.force, fusion, |_, _| Ok(()))
     }
 }
 
@@ -83,13 +84,12 @@ impl ContactReactionParams {
         &self,
         layout: &ResolvedLayout,
         cells: &LiveCells,
-        force: &ForceCharacteristic,
+        force: &PreparedForce,
         fusion: &FusionParams,
         mut row: impl FnMut(&ResolvedCell, (f64, f64)) -> Result<(), TaskError>,
     ) -> Result<ContactSummary, TaskError> {
         LengthMismatch::check_count(layout, cells.num_cells())?;
         let mut s = ContactSummary::default();
-        let force = force.prepared();
         for (i, reading) in cells.cells() {
             let sig = reading.force_signal(fusion.force_reduction);
             if sig <= fusion.activity_threshold {

@@ -185,9 +185,9 @@ fn contact_reaction_moves_touched_cell_along_minus_n() {
     let c = s.layout.patches()[forearm].cells.start + 3;
     let mut readings = vec![CellReading::uniform(0.0, 0.0); n];
     readings[c] = CellReading::uniform(0.5, 1.0);
-    let mut task = ContactReaction::new(s.model.nv(), s.params.contact_reaction);
+    let mut task = ContactReaction::new(s.model.nv(), s.params.contact_reaction, &s.skin.force);
     let mut level = TaskLevel::new("contact", s.model.nv(), n);
-    let sum = task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), &s.skin.force, &s.skin.fusion, &mut level).unwrap();
+    let sum = task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), &s.skin.fusion, &mut level).unwrap();
     assert_eq!(level.rows(), 1);
     let expected = (s.params.contact_reaction.gain * s.skin.force.force_n(0.5)).min(s.params.contact_reaction.max_force_n);
     assert_relative_eq!(sum.max_force_n, expected, epsilon = 1e-9);

@@ -142,8 +142,8 @@ fn mul_vec2_padded_kernel(a1: &[f64], a2: &[f64], x: &[f64], y1: &mut [f64], y2:
     mul_vec_streams::<2, false>([a1, a2], [x, x], [y1, y2], ld, q);
 }
 
-/// `y_s (ld) = a_s (ld × q) · x_s (q)` (`ADD`: `+=`) for `S` products at once, `PASS` blocks of `BLOCK` rows
-/// per pass over the columns: every row's sum runs over the columns in order from 0 (as in
+/// `y_s (ld) = a_s (ld × q) · x_s (q)` (`ADD`: `+=`) for `S` products at once, `PASS` blocks of
+/// `BLOCK` rows per pass over the columns: every row's sum runs over the columns in order from 0 (as in
 /// [`mul_vec`]), but `S · PASS · BLOCK / 4` independent sums share a pass, so the adds' latency
 /// (a dependent chain of q adds per sum) overlaps instead of adding up.
 #[inline(always)]
@@ -357,6 +357,13 @@ mod tests {
             let (mut got_a, mut got_y) = (a.clone(), vec![0.0; ld]);
             sub_outer_mul_vec_padded(&mut got_a, &y0, &v, &x, &mut got_y, ld, q);
             assert_eq!((got_a, got_y), (want_a, want_y), "sub_outer_mul_vec_padded, n = {n}");
+
+            // the plain kernel on the padded matrices is the reference (it has no constant paths)
+            let b = sample(q * 3, 10);
+            let (mut want_c, mut got_c) = (a.clone(), a.clone());
+            sub_mul_nt(&mut want_c, &a[..ld * 3], &b, ld, 3, q);
+            sub_mul_nt_padded(&mut got_c, &a[..ld * 3], &b, ld, 3, q);
+            assert_eq!(got_c, want_c, "sub_mul_nt_padded, n = {n}");
         }
     }
 }

@@ -424,8 +424,9 @@ impl HierarchySolver {
         Ok(())
     }
 
-    /// A force level of activated rows: the torque is the usual `τ̄_k = N_{k−1} (J_kᵀ F_k)`; the projector takes the rows one at a time, each weighted by its
-    /// activation `a_i` (continuous null-space projection, Dietrich et al. 2012):
+    /// A force level of activated rows: the torque is the usual `τ̄_k = N_{k−1} (J_kᵀ F_k)` (one
+    /// product with `N_{k−1}`, not one per row); the projector takes the rows one at a time, each
+    /// weighted by its activation `a_i` (continuous null-space projection, Dietrich et al. 2012):
     ///
     /// ```text
     /// j̄_i = j_i Nᵀ,  e_i = j̄_i M⁻¹ j̄_iᵀ,  N ← N − a_i f(e_i) (N j̄_iᵀ)(M⁻¹ j̄_iᵀ)ᵀ

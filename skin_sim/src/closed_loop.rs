@@ -192,6 +192,7 @@ impl ClosedLoop {
             link_force_n: forces.max_link_n,
             hand_position_m: forces.hand_position_m,
             hand_distance_m: forces.hand_distance_m,
+            hand_moment: out.hand_moment.into(),
             force_reference_n: scheduled.force_n,
             force_reference_signal: scheduled.force_signal,
             interaction: self.interactions.active(t_s, input.q),

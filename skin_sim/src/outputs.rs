@@ -54,8 +54,8 @@ impl RunOutput for KeyFrames {
 
 /// `figure.png`: paper 000's panels (arrangement, ee speed, proximity and contact force, torque)
 /// for a paper 000 scenario, paper 003's force-tracking panels for a scene of paper 003's phases
-/// with force references, its Fig. 6 panels (hand distance, hand and base positions) for one
-/// without (Exp. 2).
+/// with force references, its Fig. 6 panels (hand distance, skin moments at the hand, hand and
+/// base positions) for one without (Exp. 2).
 pub struct FigurePng;
 
 fn column(cycles: &[CycleRecord], f: impl Fn(&CycleRecord) -> f64) -> Vec<f64> {
@@ -79,6 +79,7 @@ impl RunOutput for FigurePng {
         let figure = if let Some(g) = guidance {
             let base = |k: usize| r.joint_names.iter().position(|j| j == BASE_JOINTS[k]).map_or_else(|| vec![f64::NAN; c.len()], |j| column(c, |c| c.q[j]));
             let hand = |k: usize| column(c, |c| c.hand_position_m[k]);
+            let moment = |k: usize| column(c, |c| c.hand_moment[k]);
             let distance = column(c, |c| if c.hand_distance_m.is_finite() { c.hand_distance_m } else { f64::NAN });
             guidance_figure(
                 &title,
@@ -86,6 +87,7 @@ impl RunOutput for FigurePng {
                     t: &t,
                     distance: &distance,
                     distance_desired: &vec![g.hand_distance_desired_m; c.len()],
+                    moment: [&moment(0), &moment(1), &moment(2)],
                     hand: [&hand(0), &hand(1), &hand(2)],
                     base: [&base(0), &base(1)],
                     interaction: &interactions,

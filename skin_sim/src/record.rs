@@ -40,6 +40,10 @@ pub struct CycleRecord {
     /// Distance ahead of the palm (along `+z_h`) to the first object or person, from MuJoCo \[m\]
     /// (infinite: nothing ahead).
     pub hand_distance_m: f64,
+    /// `ʰΓ`, the hand skin's moment in the hand frame that the controller computed (paper 003
+    /// eq. 10; normalized-signal units times metres); NaN when the controller ran elsewhere (the ROS
+    /// graph does not publish it).
+    pub hand_moment: [f64; 3],
     /// Force reference of the scene at this time \[N\] (NaN: none active).
     pub force_reference_n: f64,
     /// The hand signal reference `f_c,d` given to the controller (NaN: none).

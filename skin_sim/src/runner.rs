@@ -203,6 +203,7 @@ impl ExternalRun {
             link_force_n: forces.max_link_n,
             hand_position_m: forces.hand_position_m,
             hand_distance_m: forces.hand_distance_m,
+            hand_moment: [f64::NAN; 3],
             force_reference_n,
             force_reference_signal,
             interaction: self.interactions.active(t_s, world.q()),

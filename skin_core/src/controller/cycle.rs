@@ -114,6 +114,7 @@ impl Controller {
             fusion_weight: config.skin.fusion.weight_force,
             signals: SupervisorInput::default(),
             torque_norm: 0.0,
+            hand_moment: nalgebra::Vector3::zeros(),
         };
         Ok(Controller {
             data: ModelData::new(model),
@@ -336,13 +337,16 @@ impl Controller {
         let (hand, guidance) = (&self.hand_patches, &self.guidance_patches);
         patch_poses_world(layout, |f| data.frame_pose(f), |j| hand[j] || guidance[j], &mut self.patch_poses);
 
+        let hand = self.hand_signals();
+        self.output.hand_moment = data.frame_pose(self.ee).rotation.inverse_transform_vector(&hand.moment_world);
+
         // 3. tasks in priority order, posture, hierarchy
         let cx = CycleContext {
             model,
             data,
             config: &self.config,
             cells: &self.live,
-            hand: self.hand_signals(),
+            hand,
             goal: self.goal.as_ref(),
             sensing_range_m: arrangement.sensing_range_m,
         };

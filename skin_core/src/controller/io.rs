@@ -80,4 +80,8 @@ pub struct ControllerOutput {
     pub signals: SupervisorInput,
     /// `‖τ*‖` of the blended torque \[N m\].
     pub torque_norm: f64,
+    /// `ʰΓ` of paper 003 eq. (10): the hand patches' summed moment in the hand frame `{h}`
+    /// (normalized-signal units times metres, like the patch wrenches of eq. 8); zero without hand
+    /// patches. What the compliant wrist drives to zero (paper 003 Fig. 6b, 7b).
+    pub hand_moment: nalgebra::Vector3<f64>,
 }

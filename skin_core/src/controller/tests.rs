@@ -204,3 +204,23 @@ fn a_base_reference_is_validated_and_cleared() {
     assert!(arm.set_base_reference(Some(ok)).is_err(), "no base joints");
     arm.set_base_reference(None).unwrap();
 }
+
+#[test]
+fn hand_moment_is_the_palm_patch_moment_in_the_hand_frame() {
+    let mut c = controller("tomm");
+    let nv = c.config().model.nv();
+    let q = c.config().setup.posture.clone();
+    let layout = &c.config().layout;
+    let (palm, patch) = layout.patches().iter().enumerate().find(|(_, p)| p.id == 12).unwrap();
+    let mut cells = vec![CellReading::default(); layout.num_cells()];
+    // one off-centre cell of the palm: a moment about the patch origin
+    cells[patch.cells.start] = CellReading::uniform(0.5, 1.0);
+    let out = c.update(&ControllerInput { t_s: 0.0, dt_s: 0.008, q: &q, qd: &vec![0.0; nv], cells: &cells, scan: &[] }).clone();
+    let patch_moment = c.patch_wrenches()[palm].moment;
+    assert!(patch_moment.norm() > 1e-4, "an off-centre cell gives a moment: {patch_moment}");
+    // one patch: the same moment, rotated from the patch into the hand frame
+    assert!((out.hand_moment.norm() - patch_moment.norm()).abs() < 1e-12, "{} vs {patch_moment}", out.hand_moment);
+    let cells = vec![CellReading::default(); c.config().layout.num_cells()];
+    let out = c.update(&ControllerInput { t_s: 0.008, dt_s: 0.008, q: &q, qd: &vec![0.0; nv], cells: &cells, scan: &[] });
+    assert_eq!(out.hand_moment, Vector3::zeros(), "no touch, no moment");
+}

@@ -155,6 +155,8 @@ pub struct GuidanceSignals<'a> {
     pub distance: &'a [f64],
     /// `d_p,d` \[m\].
     pub distance_desired: &'a [f64],
+    /// `ʰΓ`, the hand skin's moment in the hand frame, x, y, z (NaN: not recorded).
+    pub moment: [&'a [f64]; 3],
     /// Hand position in the world, x, y, z \[m\].
     pub hand: [&'a [f64]; 3],
     /// Base position in the world, x, y \[m\].
@@ -164,24 +166,33 @@ pub struct GuidanceSignals<'a> {
     pub interaction: &'a [(f64, f64)],
 }
 
-/// Paper 003 Fig. 6: (a) the hand's distance to the surface against `d_p,d`, (b) the hand's
-/// position (guided along the surface by the touches), (c) the base's position (moved by base
-/// collision avoidance); interaction periods shaded. (The paper's wrist moments are not drawn.)
+/// Paper 003 Fig. 6: (a) the hand's distance to the surface against `d_p,d`, (b) the skin
+/// moments `ʰΓ` the compliant wrist drives to zero (left out when not recorded: runs through the
+/// ROS graph), (c) the hand's position (guided along the surface by the touches), (d) the base's
+/// position (moved by base collision avoidance); interaction periods shaded.
 pub fn guidance_figure(title: &str, s: &GuidanceSignals) -> Figure {
     let t = s.t;
-    let mut fig = Figure::new(title)
+    let mut fig = Figure::new(title).panel(
+        Panel::lines("(a) Hand distance to the surface", "d_p [m]")
+            .line("measured", t, s.distance)
+            .line("desired", t, s.distance_desired),
+    );
+    if s.moment.iter().any(|m| m.iter().any(|v| v.is_finite())) {
+        fig = fig.panel(
+            Panel::lines("(b) Skin moments at the hand", "h_Gamma [m]")
+                .line("x", t, s.moment[0])
+                .line("y", t, s.moment[1])
+                .line("z", t, s.moment[2]),
+        );
+    }
+    fig = fig
         .panel(
-            Panel::lines("(a) Hand distance to the surface", "d_p [m]")
-                .line("measured", t, s.distance)
-                .line("desired", t, s.distance_desired),
-        )
-        .panel(
-            Panel::lines("(b) Hand position", "w_x_h [m]")
+            Panel::lines("(c) Hand position", "w_x_h [m]")
                 .line("x", t, s.hand[0])
                 .line("y", t, s.hand[1])
                 .line("z", t, s.hand[2]),
         )
-        .panel(Panel::lines("(c) Base position", "w_x_b [m]").line("x", t, s.base[0]).line("y", t, s.base[1]));
+        .panel(Panel::lines("(d) Base position", "w_x_b [m]").line("x", t, s.base[0]).line("y", t, s.base[1]));
     for &(a, b) in s.interaction {
         fig = fig.shade(a, b, "interaction (touch, person)", Tint::Red);
     }

@@ -506,6 +506,21 @@ fn hierarchy_wide_levels_match_the_literal_formulation() {
             assert_eq!(diag[1].rank, 1, "50 copies of one row have rank 1");
         }
     }
+    // two wide levels in one solve (they share this solve's L and L⁻¹): 30 rows of rank 5, then
+    // 40 random rows that get the directions left
+    let basis = DMatrix::from_fn(5, n, |_, _| rand());
+    let ja = DMatrix::from_fn(30, 5, |_, _| rand()) * &basis;
+    let jb = DMatrix::from_fn(40, n, |_, _| rand());
+    let (fa, fb) = (DVector::from_fn(30, |_, _| rand()), DVector::from_fn(40, |_, _| rand()));
+    let (mut la, mut lb) = (TaskLevel::new("wide a", n, 30), TaskLevel::new("wide b", n, 40));
+    la.set(&ja, Reference::Force { f: fa.as_slice() }).unwrap();
+    lb.set(&jb, Reference::Force { f: fb.as_slice() }).unwrap();
+    let (tau, diag) = solve(&s, &[&l1, &la, &lb], None);
+    let x1v = DVector::from_column_slice(&x1) - &jd1;
+    let want = reference_solve(&s.m, &[(j1.clone(), x1v, false), (ja, fa, true), (jb, fb, true)], &InverseParams::default());
+    let err = (&tau - &want).amax() / want.amax().max(1.0);
+    assert!(err < 1e-8, "two wide levels: relative difference {err:e}");
+    assert_eq!((diag[1].rank, diag[2].rank), (5, n - 8), "rank 5, then what the hand and the first level left");
 }
 
 /// Levels of the strict-priority property: (link, point, Jacobian rows) per level.

@@ -453,7 +453,8 @@ fn tridiagonal_ql(v: &mut [f64], d: &mut [f64], e: &mut [f64], n: usize) {
 /// Rows (and columns) of `a` that are exactly zero come from task rows no joint moves (the
 /// out-of-plane row of a planar arm's position task, a row a higher level took whole): each is an
 /// eigenvalue 0 with a unit eigenvector, so its row and column of `out` are 0 and the other rows
-/// are inverted on their own, which usually takes the fast path below instead of the eigen
+/// are inverted on their own, which usually takes a cheaper path of [`damped_inverse_full`] (the
+/// Cholesky fast path, or the closed form for one or two rows) instead of the general eigen
 /// decomposition. Levels of more than 64 rows are inverted whole.
 pub(crate) fn damped_inverse(
     a: &mut [f64],

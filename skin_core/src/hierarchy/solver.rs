@@ -66,6 +66,8 @@ pub struct HierarchySolver {
     chol: Vec<f64>,
     chol_pad: Vec<f64>,
     linv: Vec<f64>,
+    /// `chol` and `linv` hold this solve's `L` and `L⁻¹` (set by the first wide level).
+    lower_ready: bool,
     /// `M⁻¹` and N_{k−1} (during the pass) with padded columns (`dense::padded_len`), so that
     /// the products with them run without remainder loops.
     minv_pad: Vec<f64>,
@@ -115,6 +117,7 @@ impl HierarchySolver {
             chol: vec![0.0; n * n],
             chol_pad: vec![0.0; ld * n],
             linv: vec![0.0; n * n],
+            lower_ready: false,
             jbt: vec![0.0; n * m],
             y: vec![0.0; n * m],
             z: vec![0.0; ld * m.max(n)],
@@ -219,6 +222,7 @@ impl HierarchySolver {
 
         cholesky(mass_matrix.as_slice(), &mut self.chol_pad, n, ld)?;
         spd_inverse_padded(&self.chol_pad, &mut self.z, &mut self.minv_pad, n, ld);
+        self.lower_ready = false;
         set_identity_padded(&mut self.nproj_pad, n, ld);
         self.tau_sum.fill(0.0);
         self.u_sum.fill(0.0);
@@ -348,8 +352,12 @@ impl HierarchySolver {
     fn wide_level(&mut self, k: usize, level: &TaskLevel, diag: &mut LevelDiagnostics, first: &mut bool) -> Result<(), HierarchyError> {
         let (n, m, ld) = (self.nv, level.rows(), padded_len(self.nv));
         let (nm, nn) = (n * m, n * n);
-        unpad(&self.chol_pad, &mut self.chol, n, ld, n);
-        lower_inverse_padded(&self.chol_pad, &mut self.z, &mut self.linv, n, ld);
+        if !self.lower_ready {
+            // once per solve, whatever the number of wide levels (z is free: J̄ᵀ is in jbt)
+            unpad(&self.chol_pad, &mut self.chol, n, ld, n);
+            lower_inverse_padded(&self.chol_pad, &mut self.z, &mut self.linv, n, ld);
+            self.lower_ready = true;
+        }
         // C = L⁻¹ (J̄ᵀ J̄) L⁻ᵀ, symmetrized; its eigen decomposition
         self.w[..nn].fill(0.0);
         sub_mul_nt(&mut self.w[..nn], &self.jbt[..nm], &self.jbt[..nm], n, m, n);

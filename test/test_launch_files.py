@@ -10,7 +10,7 @@ import pytest
 
 from conftest import TOP
 
-LAUNCH = sorted((TOP / "launch").glob("*.launch.py"))
+LAUNCH = sorted([*(TOP / "launch").glob("*.launch.py"), *(TOP / "skin_sim_ros" / "launch").glob("*.launch.py")])
 BINARIES = {p.stem for p in (TOP / "skin_control" / "src" / "bin").glob("*.rs")}
 
 
@@ -59,7 +59,7 @@ def test_the_colcon_install_puts_what_the_launch_files_name_into_share():
 
 
 def test_sim_launch_covers_the_graph():
-    text = (TOP / "launch" / "sim.launch.py").read_text()
+    text = (TOP / "skin_sim_ros" / "launch" / "sim.launch.py").read_text()
     for exe in ("mujoco_sim", "task_controller", "priority_supervisor", "skin_aggregator", "robot_state_publisher"):
         assert f'executable="{exe}"' in text
     assert (TOP / "config" / "skin.rviz").read_text().count("/skin/markers") == 1

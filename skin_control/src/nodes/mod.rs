@@ -10,7 +10,6 @@ use anyhow::{Context as _, Result};
 
 use crate::paths;
 
-pub mod mujoco_sim;
 pub mod priority_supervisor;
 pub mod task_controller;
 
@@ -42,6 +41,13 @@ pub mod topics {
     pub const SET_PHASE: &str = "/supervisor/set_phase";
     /// Simulation clock (rosgraph_msgs/Clock).
     pub const CLOCK: &str = "/clock";
+}
+
+/// `TOPIC=N` of `--wait-topic-subscribers`.
+pub fn topic_count(s: &str) -> Result<(String, usize), String> {
+    let (topic, n) = s.split_once('=').ok_or_else(|| format!("`{s}`: expected TOPIC=N"))?;
+    let n = n.parse().map_err(|e| format!("`{s}`: count `{n}`: {e}"))?;
+    Ok((topic.to_string(), n))
 }
 
 /// A start-up setting: the command-line option, else the ROS parameter `key`, else `default`.
@@ -133,7 +139,7 @@ pub struct SubscriberWait {
     /// matched subscribers in other processes, then print `ready` on stdout; e.g.
     /// `/skin/patches=1` when a recorder must get the first message (a volatile publisher drops
     /// what it sends before discovery has matched a subscriber).
-    #[arg(long, num_args = 1.., value_name = "TOPIC=N", value_parser = crate::rosbag::play::topic_count)]
+    #[arg(long, num_args = 1.., value_name = "TOPIC=N", value_parser = topic_count)]
     pub wait_topic_subscribers: Vec<(String, usize)>,
 }
 

@@ -33,12 +33,12 @@ use r2r::skin_msgs::msg::{Arrangement, ControllerState, SkinCellArray};
 use r2r::std_msgs::msg::{Float64, Float64MultiArray};
 use skin_sim::runner::{ExternalRun, RunTarget};
 
-use super::topics::*;
-use super::Pass;
-use crate::convert::robot::time_msg;
-use crate::qos;
+use skin_control::nodes::topics::*;
+use skin_control::nodes::Pass;
+use skin_control::convert::robot::time_msg;
+use skin_control::qos;
 use crate::sim_bridge::{decision, AppliedCommand, SimBridge, SimMessages};
-use crate::task_controller::ArmsParams;
+use skin_control::task_controller::ArmsParams;
 
 /// Node name.
 pub const NODE: &str = "mujoco_sim";
@@ -66,7 +66,7 @@ pub struct Options {
     /// Without it, a first state sent before discovery completes is lost and sent again after
     /// `--resend` (waiting only for the inputs' readers is not enough: the controller's command
     /// and state writers must be matched too).
-    #[arg(long, num_args = 1.., value_name = "TOPIC=N", value_parser = crate::rosbag::play::topic_count)]
+    #[arg(long, num_args = 1.., value_name = "TOPIC=N", value_parser = skin_control::nodes::topic_count)]
     pub wait_topic_subscribers: Vec<(String, usize)>,
     /// Command namespaces, one per arm (default: /left_arm /right_arm for TOMM, else /arm).
     #[arg(long = "arm-namespace", value_name = "NS")]
@@ -193,7 +193,7 @@ impl SimHandle {
             CLOCK => Some(p.clock.get_inter_process_subscription_count()),
             _ => None,
         };
-        let lacking = super::lacking_subscribers(&self.options.wait_topic_subscribers, count).map_err(|e| {
+        let lacking = skin_control::nodes::lacking_subscribers(&self.options.wait_topic_subscribers, count).map_err(|e| {
             anyhow::anyhow!("--wait-topic-subscribers: {e} (inputs: {JOINT_STATES}, {CELLS}, {ODOM}, {SCAN}, {CLOCK})")
         })?;
         if !lacking.is_empty() && self.started.elapsed() > Duration::from_secs(30) {

@@ -1,11 +1,12 @@
 """MuJoCo simulation of a scene with the skin control graph.
 
-    ros2 launch skin_control sim.launch.py scene:=intentional_contact setup:=config/controller/planar7.yaml
-    ros2 launch skin_control sim.launch.py scene:=tomm_movable_obstacles rviz:=true
+    ros2 launch skin_sim_ros sim.launch.py scene:=intentional_contact setup:=config/controller/planar7.yaml
+    ros2 launch skin_sim_ros sim.launch.py scene:=tomm_movable_obstacles rviz:=true
 
 Starts mujoco_sim (real time, or lockstep:=true), task_controller, priority_supervisor,
 skin_aggregator (all on sim time), robot_state_publisher with our URDF, and RViz on request.
-Paths are relative to the skin_control share directory (the nodes also look there)."""
+Paths are relative to the skin_control share directory (the nodes also look there); mujoco_sim
+comes from this package, skin_sim_ros, the other nodes from the robot package skin_control."""
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
 from launch.conditions import IfCondition
@@ -15,6 +16,7 @@ from launch_ros.substitutions import FindPackageShare
 from launch.substitutions import PathJoinSubstitution
 
 PKG = "skin_control"
+SIM_PKG = "skin_sim_ros"
 
 
 def share(*parts):
@@ -35,7 +37,7 @@ def generate_launch_description():
         DeclareLaunchArgument("urdf", default_value="urdf/tomm.urdf", description="robot URDF for robot_state_publisher"),
         DeclareLaunchArgument("lockstep", default_value="false", description="reproducible lockstep simulation"),
         DeclareLaunchArgument("rviz", default_value="false", description="start RViz with config/skin.rviz"),
-        Node(package=PKG, executable="mujoco_sim", name="mujoco_sim", output="screen",
+        Node(package=SIM_PKG, executable="mujoco_sim", name="mujoco_sim", output="screen",
              arguments=["--scene", scene,
                         PythonExpression(["'--lockstep' if '", lockstep, "' == 'true' else '--realtime-factor=1'"])]),
         Node(package=PKG, executable="task_controller", name="task_controller", output="screen",

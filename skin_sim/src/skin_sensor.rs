@@ -71,6 +71,8 @@ pub struct SkinSensor {
     /// Cell indices ordered by body, and each MuJoCo body's range in that order.
     by_body: Vec<usize>,
     body_range: Vec<Range<usize>>,
+    /// Per MuJoCo body: the sphere (center in the body frame, radius) holding its cells.
+    body_sphere: Vec<(Point3<f64>, f64)>,
     proximity: PreparedProximity,
     rays: ProximityRays,
     force: PreparedForce,
@@ -80,6 +82,8 @@ pub struct SkinSensor {
     noise: Noise,
     /// Scratch: normal force per cell \[N\].
     force_n: Vec<f64>,
+    /// Scratch: the proximity ray's hit distance per cell \[m\].
+    distance_m: Vec<Option<f64>>,
     /// Scratch: this sample's contacts, one per pair of touching geoms.
     patches: Vec<ContactPatch>,
     /// Scratch: weight of each cell of one body (in `by_body` order) in a patch's split.
@@ -104,6 +108,14 @@ pub const TOUCH_RADIUS_M: f64 = 0.05;
 /// Smallest `-n_i · u` a loaded cell is credited with in the force balance of
 /// [`SkinSensor::distribute`]: a cell reads at most twice the contact force.
 const MIN_FACING: f64 = 0.5;
+
+/// A sphere holding `points`: their centroid and the largest distance from it (zero radius at
+/// the origin for none).
+fn bounding_sphere(points: impl Iterator<Item = Point3<f64>> + Clone) -> (Point3<f64>, f64) {
+    let n = points.clone().count().max(1) as f64;
+    let center = Point3::from(points.clone().fold(Vector3::zeros(), |s, p| s + p.coords) / n);
+    (center, points.map(|p| (p - center).norm()).fold(0.0, f64::max))
+}
 
 /// Noise stream of the skin (see [`Noise::new`]).
 const NOISE_STREAM: u64 = 1;
@@ -138,12 +150,14 @@ impl SkinSensor {
                 let end = by_body.partition_point(|&i| cells[i].body <= b);
                 start..end
             })
-            .collect();
+            .collect::<Vec<_>>();
+        let body_sphere = body_range.iter().map(|r| bounding_sphere(by_body[r.clone()].iter().map(|&i| cells[i].position))).collect();
         let n = cells.len();
         Some(SkinSensor {
             cells,
             by_body,
             body_range,
+            body_sphere,
             proximity: skin.params.proximity.prepared(),
             rays: ProximityRays::new(mj, skin.params.proximity.range_m),
             force: skin.params.force.prepared(),
@@ -152,6 +166,7 @@ impl SkinSensor {
             force_noise_std: spec.force_noise_std,
             noise: Noise::new(scene.spec.seed, NOISE_STREAM),
             force_n: vec![0.0; n],
+            distance_m: vec![None; n],
             patches: Vec::new(),
             weights: Vec::new(),
             readings: vec![CellReading::default(); n],
@@ -176,12 +191,13 @@ impl SkinSensor {
         for t in touches {
             self.distribute_touch(data, &t);
         }
+        self.cast_rays(data);
         for i in 0..self.cells.len() {
             if !self.cells[i].active {
                 continue;
             }
             let f = self.force_n[i];
-            let p = if f > 0.0 { 1.0 } else { self.ray_proximity(data, i) };
+            let p = if f > 0.0 { 1.0 } else { self.distance_m[i].map_or(0.0, |d| self.proximity.signal(d)) };
             let force = self.force.signal(f);
             let mut reading = CellReading {
                 force: [force; 3],
@@ -195,9 +211,28 @@ impl SkinSensor {
         }
     }
 
-    fn ray_proximity<M: ModelType>(&self, data: &mut MjData<M>, i: usize) -> f64 {
-        let (p, n) = self.cell_world(data, i);
-        self.rays.cast(data, p, n).map_or(0.0, |d| self.proximity.signal(d))
+    /// Fills `distance_m` for the active cells not in contact, body by body: a body with no
+    /// sensed geom near its cells casts no ray ([`ProximityRays::select_near`]).
+    fn cast_rays<M: ModelType>(&mut self, data: &mut MjData<M>) {
+        self.distance_m.fill(None);
+        for b in 0..self.body_range.len() {
+            let cells = self.body_range[b].clone();
+            if cells.is_empty() {
+                continue;
+            }
+            let pose = body_pose(data, b);
+            let (center, radius) = self.body_sphere[b];
+            if !self.rays.select_near(data, pose * center, radius) {
+                continue;
+            }
+            for &i in &self.by_body[cells] {
+                let c = &self.cells[i];
+                let in_contact = self.force_n[i] > 0.0;
+                if c.active && !in_contact {
+                    self.distance_m[i] = self.rays.cast(data, pose * c.position, pose * c.normal);
+                }
+            }
+        }
     }
 
     /// Fills `force_n` with each cell's share of the normal contact forces on the robot. MuJoCo
@@ -303,5 +338,48 @@ impl SkinSensor {
         for (&i, w) in self.by_body[range].iter().zip(&self.weights) {
             self.force_n[i] += w * scale;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::World;
+
+    /// Culling by body changes no reading: every cell's proximity distance equals the one its
+    /// own ray gets against the geoms near that cell alone, over the motion of a scene whose
+    /// arm sweeps past obstacles.
+    #[test]
+    fn the_body_culled_rays_read_what_each_cell_reads_alone() {
+        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/scenes/tomm_movable_obstacles.yaml");
+        let mut world = World::from_scene_file(&file).unwrap();
+        let (mut hits, mut culled) = (0, 0);
+        for _ in 0..6 {
+            for _ in 0..250 {
+                world.step();
+            }
+            let mut data = world.mj_data().clone();
+            let mut sensor = world.skin().unwrap().clone();
+            sensor.contact_forces(&data);
+            sensor.cast_rays(&mut data);
+            for i in 0..sensor.cells.len() {
+                let (p, n) = sensor.cell_world(&data, i);
+                let alone = sensor.rays.select_near(&data, p, 0.0);
+                let in_contact = sensor.force_n[i] > 0.0;
+                let expected = if sensor.cells[i].active && !in_contact && alone { sensor.rays.cast(&mut data, p, n) } else { None };
+                assert_eq!(sensor.distance_m[i], expected, "cell {i}");
+                hits += usize::from(expected.is_some());
+                culled += usize::from(!alone);
+            }
+        }
+        assert!(hits > 0 && culled > 0, "the scene must both hit and cull: {hits} hits, {culled} culled");
+    }
+
+    #[test]
+    fn the_bounding_sphere_holds_its_points() {
+        let points = [Point3::new(0.0, 0.0, 0.0), Point3::new(0.2, 0.0, 0.0), Point3::new(0.1, 0.1, -0.1)];
+        let (c, r) = bounding_sphere(points.iter().copied());
+        assert!(points.iter().all(|p| (p - c).norm() <= r + 1e-15));
+        assert_eq!(bounding_sphere(std::iter::empty()), (Point3::origin(), 0.0));
     }
 }

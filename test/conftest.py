@@ -145,3 +145,40 @@ def cell_array(entries, stamp=None):
     if stamp is not None:
         msg.header.stamp = stamp
     return msg
+
+
+def ros2_or_skip():
+    """The `ros2` command line with the launch system, or skip the test saying how to get it."""
+    import shutil
+
+    exe = shutil.which("ros2")
+    probe = exe and subprocess.run([exe, "launch", "--help"], capture_output=True).returncode == 0
+    if not probe:
+        pytest.skip("needs the ROS 2 Jazzy command line (`ros2 launch`): on a robot source "
+                    "/opt/ros/jazzy/setup.bash; here set ROS2_PYTHON_TOOLS to a directory with the "
+                    "upstream launch/ros2cli sources and their `install` script, then re-run scripts/bootstrap")
+    return exe
+
+
+@pytest.fixture(scope="session")
+def ament_prefix(tmp_path_factory):
+    """skin_control installed as `colcon build` installs it (cargo-ament-build's layout: the ament
+    index marker, share/skin_control/{package.xml, launch, config, urdf}, lib/skin_control/<bins>),
+    with links to the repository and the build under test; returns the environment that puts it
+    first on AMENT_PREFIX_PATH, for `ros2 launch skin_control ...`."""
+    prefix = tmp_path_factory.mktemp("install")
+    index = prefix / "share" / "ament_index" / "resource_index" / "packages"
+    index.mkdir(parents=True)
+    (index / "skin_control").write_text("")
+    share = prefix / "share" / "skin_control"
+    share.mkdir()
+    (share / "package.xml").symlink_to(TOP / "skin_control" / "package.xml")
+    for d in ("launch", "config", "urdf"):
+        (share / d).symlink_to(TOP / d)
+    lib = prefix / "lib" / "skin_control"
+    lib.mkdir(parents=True)
+    for exe in ("mujoco_sim", "task_controller", "priority_supervisor", "skin_aggregator"):
+        (lib / exe).symlink_to(binary(exe))
+    env = dict(os.environ)
+    env["AMENT_PREFIX_PATH"] = f"{prefix}:{env.get('AMENT_PREFIX_PATH', '')}"
+    return env

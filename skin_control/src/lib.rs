@@ -17,3 +17,4 @@ pub mod shutdown;
 pub mod sim_bridge;
 pub mod supervisor_node;
 pub mod task_controller;
+pub mod tf;

@@ -164,8 +164,10 @@ def ros2_or_skip():
 def ament_prefix(tmp_path_factory):
     """skin_control installed as `colcon build` installs it (cargo-ament-build's layout: the ament
     index marker, share/skin_control/{package.xml, launch, config, urdf}, lib/skin_control/<bins>),
-    with links to the repository and the build under test; returns the environment that puts it
+    copied from the repository, the binaries linked to the build under test; returns the environment that puts it
     first on AMENT_PREFIX_PATH, for `ros2 launch skin_control ...`."""
+    import shutil
+
     prefix = tmp_path_factory.mktemp("install")
     index = prefix / "share" / "ament_index" / "resource_index" / "packages"
     index.mkdir(parents=True)
@@ -174,7 +176,7 @@ def ament_prefix(tmp_path_factory):
     share.mkdir()
     (share / "package.xml").symlink_to(TOP / "skin_control" / "package.xml")
     for d in ("launch", "config", "urdf"):
-        (share / d).symlink_to(TOP / d)
+        shutil.copytree(TOP / d, share / d)
     lib = prefix / "lib" / "skin_control"
     lib.mkdir(parents=True)
     for exe in ("mujoco_sim", "task_controller", "priority_supervisor", "skin_aggregator"):

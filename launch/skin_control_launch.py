@@ -1,11 +1,14 @@
-"""What sim.launch.py and tomm.launch.py share: the scene's description (from mujoco_sim itself),
-the URDF as robot_state_publisher must see it, and the skin control graph's nodes.
+"""What the launch files share (tomm.launch.py here, skin_sim_ros's sim.launch.py): the robot's
+description (from a controller setup, or from mujoco_sim for a scene), the URDF as
+robot_state_publisher must see it, and the skin control graph's nodes.
 
-Not a launch file itself: the launch files import it from their own directory."""
+Not a launch file itself: the launch files import it from skin_control's share/launch."""
 import json
 import os
 import subprocess
 import xml.etree.ElementTree as ET
+
+import yaml
 
 from launch.conditions import IfCondition
 from launch.substitutions import LaunchConfiguration
@@ -14,6 +17,8 @@ from launch_ros.parameter_descriptions import ParameterValue
 from ament_index_python.packages import get_package_prefix, get_package_share_directory
 
 PKG = "skin_control"
+# The simulation package (mujoco_sim); only hardware:=sim and sim.launch.py need it.
+SIM_PKG = "skin_sim_ros"
 # The base frame the base driver (or mujoco_sim) places in odom (REP 105).
 BASE_FRAME = "base_link"
 
@@ -26,12 +31,28 @@ def share_file(*parts):
 def describe(scene, setup=""):
     """mujoco_sim --describe: the scene's controller setup (the scenario's unless `setup`), URDF,
     skin layout, LIDAR, base and arm namespaces; the one place that knows the scenarios."""
-    exe = os.path.join(get_package_prefix(PKG), "lib", PKG, "mujoco_sim")
+    exe = os.path.join(get_package_prefix(SIM_PKG), "lib", SIM_PKG, "mujoco_sim")
     cmd = [exe, "--describe", "--scene", scene] + (["--controller", setup] if setup else [])
     run = subprocess.run(cmd, capture_output=True, text=True)
     if run.returncode != 0:
         raise RuntimeError(f"scene:={scene}: {run.stderr.strip() or run.stdout.strip()}")
     return json.loads(run.stdout)
+
+
+def setup_files(setup):
+    """The URDF and skin layout a controller setup file names (following its `base` files; paths
+    relative to the file that sets them), as absolute paths: the robot's files without a scene."""
+    found, path = {}, os.path.abspath(setup)
+    while path and not {"urdf", "skin_layout"} <= set(found):
+        data = yaml.safe_load(open(path))
+        for key in ("urdf", "skin_layout"):
+            if key in data and key not in found:
+                found[key] = os.path.normpath(os.path.join(os.path.dirname(path), data[key]))
+        path = os.path.join(os.path.dirname(path), data["base"]) if "base" in data else None
+    missing = {"urdf", "skin_layout"} - set(found)
+    if missing:
+        raise RuntimeError(f"setup:={setup}: names no {', '.join(sorted(missing))}")
+    return found["urdf"], found["skin_layout"]
 
 
 def mounted_description(urdf_text):

@@ -24,8 +24,8 @@ and takes base/cmd_vel (geometry_msgs/Twist); the skin driver publishes skin/cel
 (tf2_ros) makes the goals' world frame the odometry frame, as the controller takes it
 (`world_tf:=false` when a localization publishes it).
 
-hardware:=sim: mujoco_sim runs `scene` instead of the drivers, on the same topics (the arms'
-commands in their namespaces, joint_states, base/odom, scan, skin/cells, TF)."""
+hardware:=sim: mujoco_sim (package skin_sim_ros) runs `scene` instead of the drivers, on the same
+topics (the arms' commands in their namespaces, joint_states, base/odom, scan, skin/cells, TF)."""
 import os
 import sys
 
@@ -37,7 +37,7 @@ from launch_ros.parameter_descriptions import ParameterFile, ParameterValue
 from launch_ros.substitutions import FindPackageShare
 
 sys.path.insert(0, os.path.dirname(os.path.realpath(__file__)))
-from skin_control_launch import PKG, describe, graph_nodes, share_file  # noqa: E402
+from skin_control_launch import SIM_PKG, describe, graph_nodes, setup_files, share_file  # noqa: E402
 
 SIDES = ("left", "right")
 PORTS = ("reverse_port", "script_sender_port", "trajectory_port", "script_command_port")
@@ -102,16 +102,20 @@ def launch_setup(context):
     ns, sim = arg("namespace"), arg("hardware") == "sim"
     if arg("hardware") not in ("real", "sim"):
         raise RuntimeError(f"hardware:={arg('hardware')}: must be real or sim")
-    # The robot's files come from the controller setup; the real TOMM has its LIDAR, a scene may not.
-    description = describe(arg("scene"), arg("setup") or ("" if sim else share_file("config", "controller", "tomm.yaml")))
-    if not sim:
-        description["lidar"] = description["base"]
     arm_list = arms(arg)
-    if [a["tf_prefix"] for a in arm_list] != description["arms"]["joint_prefixes"]:
-        raise RuntimeError(f"scene:={arg('scene')}: not a TOMM scene (arms {description['arms']})")
+    if sim:
+        # The scene's robot and setup (skin_sim_ros's mujoco_sim knows the scenarios).
+        description = describe(arg("scene"), arg("setup"))
+        if [a["tf_prefix"] for a in arm_list] != description["arms"]["joint_prefixes"]:
+            raise RuntimeError(f"scene:={arg('scene')}: not a TOMM scene (arms {description['arms']})")
+    else:
+        # The real TOMM: the setup's files, its base and LIDAR.
+        setup = os.path.abspath(arg("setup") or share_file("config", "controller", "tomm.yaml"))
+        urdf, layout = setup_files(setup)
+        description = {"setup": setup, "urdf": urdf, "layout": layout, "lidar": True, "base": True}
     namespaces = [a["namespace"] for a in arm_list]
     if sim:
-        robot = [Node(package=PKG, executable="mujoco_sim", name="mujoco_sim", namespace=ns, output="screen",
+        robot = [Node(package=SIM_PKG, executable="mujoco_sim", name="mujoco_sim", namespace=ns, output="screen",
                       arguments=["--scene", description["scene"], "--realtime-factor", "1.0",
                                  *[x for n in namespaces for x in ("--arm-namespace", n)],
                                  *[x for a in arm_list for x in ("--arm-prefix", a["tf_prefix"])]])]

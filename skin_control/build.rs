@@ -1,22 +1,12 @@
-//! Link fixes for ROS 2 from PyPI wheels, so the binaries run without sourcing anything.
+//! Link settings for ROS 2 (wheels or /opt/ros): see the `skin_ros_link` crate; and `cfg(tf2_msgs)`.
 fn main() {
-    // librcl.so from the wheels needs CPython symbols (its Python typesupport dependencies do not
-    // link libpython): without this, binaries die with "undefined symbol: PyExc_RuntimeError".
-    println!("cargo:rustc-link-arg=-Wl,--push-state,--no-as-needed,-lpython3.11,--pop-state");
-    // The wheels' own RPATHs are wrong once installed into a venv: embed ours (DT_RPATH, which,
-    // unlike RUNPATH, also applies to the libraries' own dependencies). scripts/bootstrap writes it.
-    println!("cargo:rerun-if-env-changed=SKIN_RPATH");
-    if let Ok(rpath) = std::env::var("SKIN_RPATH") {
-        if !rpath.is_empty() {
-            println!("cargo:rustc-link-arg=-Wl,--disable-new-dtags,-rpath,{rpath}");
-        }
-    }
+    skin_ros_link::emit();
     tf2_msgs_cfg();
 }
 
 /// `cfg(tf2_msgs)` when r2r generates tf2_msgs (installed in an AMENT_PREFIX_PATH prefix and not
 /// filtered out): the type of `/tf`, which the wheels lack (a robot's /opt/ros/jazzy has it; here
-/// scripts/bootstrap installs it with ROS2_PYTHON_TOOLS). Without it `mujoco_sim` publishes no TF.
+/// scripts/bootstrap installs it with ROS2_PYTHON_TOOLS). Without it `skin_control::tf` publishes no TF.
 fn tf2_msgs_cfg() {
     println!("cargo:rustc-check-cfg=cfg(tf2_msgs)");
     println!("cargo:rerun-if-env-changed=AMENT_PREFIX_PATH");

@@ -162,25 +162,28 @@ def ros2_or_skip():
 
 @pytest.fixture(scope="session")
 def ament_prefix(tmp_path_factory):
-    """skin_control installed as `colcon build` installs it (cargo-ament-build's layout: the ament
-    index marker, share/skin_control/{package.xml, launch, config, urdf}, lib/skin_control/<bins>),
-    copied from the repository, the binaries linked to the build under test; returns the environment that puts it
-    first on AMENT_PREFIX_PATH, for `ros2 launch skin_control ...`."""
+    """skin_control and skin_sim_ros installed as `colcon build` installs them (cargo-ament-build's
+    layout: the ament index markers, share/<pkg>/{package.xml, launch, ...}, lib/<pkg>/<bins>),
+    copied from the repository, the binaries linked to the build under test; returns the
+    environment that puts the prefix first on AMENT_PREFIX_PATH, for `ros2 launch <pkg> ...`."""
     import shutil
 
     prefix = tmp_path_factory.mktemp("install")
     index = prefix / "share" / "ament_index" / "resource_index" / "packages"
     index.mkdir(parents=True)
-    (index / "skin_control").write_text("")
-    share = prefix / "share" / "skin_control"
-    share.mkdir()
-    (share / "package.xml").symlink_to(TOP / "skin_control" / "package.xml")
-    for d in ("launch", "config", "urdf"):
-        shutil.copytree(TOP / d, share / d)
-    lib = prefix / "lib" / "skin_control"
-    lib.mkdir(parents=True)
-    for exe in ("mujoco_sim", "task_controller", "priority_supervisor", "skin_aggregator"):
-        (lib / exe).symlink_to(binary(exe))
+    packages = {"skin_control": (["launch", "config", "urdf"], ["task_controller", "priority_supervisor", "skin_aggregator"]),
+                "skin_sim_ros": (["skin_sim_ros/launch"], ["mujoco_sim"])}
+    for pkg, (dirs, exes) in packages.items():
+        (index / pkg).write_text("")
+        share = prefix / "share" / pkg
+        share.mkdir()
+        (share / "package.xml").symlink_to(TOP / pkg / "package.xml")
+        for d in dirs:
+            shutil.copytree(TOP / d, share / d.rsplit("/", 1)[-1])
+        lib = prefix / "lib" / pkg
+        lib.mkdir(parents=True)
+        for exe in exes:
+            (lib / exe).symlink_to(binary(exe))
     env = dict(os.environ)
     env["AMENT_PREFIX_PATH"] = f"{prefix}:{env.get('AMENT_PREFIX_PATH', '')}"
     return env

@@ -1,7 +1,7 @@
-"""rosbag2 MCAP interoperability of `skin_sim::bag` with rosbags (an independent pure-Python
+"""rosbag2 MCAP interoperability of the `skin_bag` crate with rosbags (an independent pure-Python
 rosbag2 implementation) as the outside peer, both directions.
 
-The skin_sim example `write_bag` writes one message of every topic type of the graph; rosbags reads
+The skin_bag example `write_bag` writes one message of every topic type of the graph; rosbags reads
 it, builds its types from the definitions stored in the bag, and every field must equal the values
 below. Then rosbags writes the same messages and `write_bag --check` reads them back in Rust."""
 import subprocess

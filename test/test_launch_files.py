@@ -1,8 +1,8 @@
 """The launch files name only things that exist, also where no `ros2` command line is installed
-(test_launch_sim.py runs them). Each file is parsed (ast): every `executable=` of a skin_control
-Node must be a skin_control binary (skin_control/src/bin/<name>.rs), every file named through
-`share_file(...)` must exist in the package and be installed to its share directory on a colcon
-build (skin_control/Cargo.toml's `install_to_share`)."""
+(test_launch_sim.py runs them). Each file is parsed (ast): every `executable=` of a Node of our
+packages must be a binary of that package (skin_control/src/bin, skin_sim_ros/src/bin), every file
+named through `share_file(...)` must exist in skin_control and be installed to its share directory
+on a colcon build (the packages' `install_to_share`)."""
 import ast
 import tomllib
 
@@ -11,8 +11,9 @@ import yaml
 
 from conftest import TOP
 
-LAUNCH = sorted((TOP / "launch").glob("*.py"))
-BINARIES = {p.stem for p in (TOP / "skin_control" / "src" / "bin").glob("*.rs")}
+LAUNCH = sorted([*(TOP / "launch").glob("*.py"), *(TOP / "skin_sim_ros" / "launch").glob("*.py")])
+PACKAGES = {"PKG": "skin_control", "SIM_PKG": "skin_sim_ros"}
+BINARIES = {pkg: {p.stem for p in (TOP / pkg / "src" / "bin").glob("*.rs")} for pkg in PACKAGES.values()}
 
 
 def calls(tree, name):
@@ -32,9 +33,10 @@ def test_launch_file_names_existing_things(path):
     for call in calls(tree, "Node"):
         kw = {k.arg: k.value for k in call.keywords}
         pkg = kw.get("package")
-        if isinstance(pkg, ast.Name) and pkg.id == "PKG" or const(pkg) == "skin_control":
+        pkg = PACKAGES.get(pkg.id) if isinstance(pkg, ast.Name) else const(pkg)
+        if pkg in BINARIES:
             exe = const(kw["executable"])
-            assert exe in BINARIES, f"{path.name}: executable {exe} is not a skin_control binary {sorted(BINARIES)}"
+            assert exe in BINARIES[pkg], f"{path.name}: executable {exe} is not a {pkg} binary {sorted(BINARIES[pkg])}"
     for c in calls(tree, "share_file"):
         parts = [const(a) for a in c.args]
         if all(parts):
@@ -47,6 +49,8 @@ def test_the_colcon_install_puts_what_the_launch_files_name_into_share():
     entries = manifest["package"]["metadata"]["ros"]["install_to_share"]
     installed = {(TOP / "skin_control" / e).resolve().relative_to(TOP).as_posix(): e.rsplit("/", 1)[-1] for e in entries}
     assert installed.get("launch") == "launch", "the launch files themselves (ros2 launch skin_control ...)"
+    sim = tomllib.loads((TOP / "skin_sim_ros" / "Cargo.toml").read_text())["package"]["metadata"]["ros"]
+    assert "launch" in sim["install_to_share"], "ros2 launch skin_sim_ros sim.launch.py"
     for path in LAUNCH:
         tree = ast.parse(path.read_text(), filename=str(path))
         for c in calls(tree, "share_file"):

@@ -22,11 +22,11 @@ GLOBAL_TOPICS = {"/clock", "/tf", "/tf_static", "/rosout", "/parameter_events"}
 
 
 class Launch:
-    """`ros2 launch skin_control <file> <args>` in its own session; stopped with SIGINT."""
+    """`ros2 launch <pkg> <file> <args>` in its own session; stopped with SIGINT."""
 
-    def __init__(self, env, log, file, *args):
+    def __init__(self, env, log, pkg, file, *args):
         self.log = log
-        self.proc = subprocess.Popen(["ros2", "launch", "skin_control", file, *args], env=env,
+        self.proc = subprocess.Popen(["ros2", "launch", pkg, file, *args], env=env,
                                      stdout=open(log, "w"), stderr=subprocess.STDOUT, start_new_session=True)
 
     def output(self):
@@ -65,8 +65,8 @@ def launch(ament_prefix, tmp_path):
     ros2_or_skip()
     started = []
 
-    def _launch(file, *args):
-        started.append(Launch(ament_prefix, tmp_path / f"launch{len(started)}.log", file, *args))
+    def _launch(pkg, file, *args):
+        started.append(Launch(ament_prefix, tmp_path / f"launch{len(started)}.log", pkg, file, *args))
         return started[-1]
 
     yield _launch
@@ -172,7 +172,7 @@ def test_sim_launch(scene, ns, launch, rclpy_node):
     d = describe(scene)
     pre = f"/{ns}" if ns else ""
     watch = Watch(rclpy_node, pre, d)
-    la = launch("sim.launch.py", f"scene:={scene}", "robot_state_publisher:=false", *([f"namespace:={ns}"] if ns else []))
+    la = launch("skin_sim_ros", "sim.launch.py", f"scene:={scene}", "robot_state_publisher:=false", *([f"namespace:={ns}"] if ns else []))
 
     # The controller cycles on the scene's inputs (a TOMM scene without LIDAR: use_scan follows it).
     la.wait_for(rclpy_node, lambda: watch.fresh(20), "20 fresh controller states")

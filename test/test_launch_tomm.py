@@ -81,7 +81,7 @@ def test_sim_hardware_speaks_the_drivers_topics(launch, rclpy_node):  # noqa: F8
     watch = Watch(rclpy_node, "", d)
     joints = []
     rclpy_node.create_subscription(JointState, "/joint_states", joints.append, 100)
-    la = launch("tomm.launch.py", "hardware:=sim", "robot_state_publisher:=false")
+    la = launch("skin_control", "tomm.launch.py", "hardware:=sim", "robot_state_publisher:=false")
     la.wait_for(rclpy_node, lambda: watch.fresh(20), "20 fresh controller states")
     # The simulator takes each arm's commands where its driver would (the arm's namespace) ...
     for ns in ("left_arm", "right_arm"):
@@ -102,3 +102,20 @@ def test_sim_hardware_speaks_the_drivers_topics(launch, rclpy_node):  # noqa: F8
     rc, alive = la.interrupt()
     assert not alive and rc == 0 and "has died" not in la.output(), la.output()[-3000:]
     spin_until(rclpy_node, watch.last_commands_zero, 10.0, "zero commands last")
+
+
+@pytest.mark.parametrize("scene", ["intentional_contact", "tomm_movable_obstacles", "tactile_guidance"])
+def test_the_real_robot_path_reads_a_setup_as_the_controller_does(scene, ament_prefix, monkeypatch):
+    """hardware:=real takes the URDF and skin layout from the controller setup without a scene
+    (skin_control_launch.setup_files, following `base` files): the same files mujoco_sim
+    --describe resolves through skin_core for the scenario's setup."""
+    import os
+    import sys
+
+    monkeypatch.setenv("AMENT_PREFIX_PATH", ament_prefix["AMENT_PREFIX_PATH"])
+    pytest.importorskip("launch_ros", reason="needs the ROS 2 launch system (see conftest.ros2_or_skip)")
+    sys.path.insert(0, str(TOP / "launch"))
+    from skin_control_launch import setup_files
+
+    d = describe(scene)
+    assert tuple(map(os.path.realpath, setup_files(d["setup"]))) == (d["urdf"], d["layout"])

@@ -11,7 +11,7 @@ use skin_core::resolver::{Resolver, ResolverParams};
 use skin_core::skin::layout::{ResolvedLayout, SkinLayout};
 use skin_core::skin::params::SkinParams;
 use skin_core::skin::signals::CellReading;
-use skin_core::skin::yaml;
+use skin_core::param_file::yaml;
 use skin_core::supervisor::{Supervisor, SupervisorParams};
 use skin_core::tasks::params::TaskParams;
 

@@ -1,7 +1,8 @@
 //! skin_control: the ROS 2 (Jazzy) layer of the system. Nodes are thin: messages are converted to
 //! `skin_core` types in one place ([`convert`]), then the control law in `skin_core` does the work.
-//! The nodes' work without ROS is in [`aggregator`], [`task_controller`], [`supervisor_node`] and
-//! [`sim_bridge`]; their wiring in [`nodes`]; the bag tool `skin_bag` in [`rosbag`].
+//! The nodes' work without ROS is in [`aggregator`], [`task_controller`] and [`supervisor_node`];
+//! their wiring in [`nodes`]; the bag tool `skin_bag` in [`rosbag`]. This is the robot package: it
+//! never links MuJoCo (the simulation nodes are the `skin_sim_ros` package).
 #![warn(missing_docs)]
 
 pub mod aggregator;
@@ -14,7 +15,6 @@ pub mod qos;
 pub mod ros_params;
 pub mod rosbag;
 pub mod shutdown;
-pub mod sim_bridge;
 pub mod supervisor_node;
 pub mod task_controller;
 pub mod tf;

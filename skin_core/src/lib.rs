@@ -43,6 +43,7 @@ macro_rules! avx2_dispatch {
 pub mod controller;
 pub mod hierarchy;
 pub mod model;
+pub mod param_file;
 pub mod resolver;
 pub mod skin;
 pub mod supervisor;

@@ -7,22 +7,20 @@
 //! - [`skin_sensor`] and [`lidar`]: the simulated sensors;
 //! - [`noise`]: seeded Gaussian noise;
 //! - [`closed_loop`]: the world and a skin_core `Controller` in lockstep, with the scene's
-//!   [`schedule`] (goals, force references via [`hand_force`], phases), the [`interaction`]
+//!   [`schedule`] (goals, force references through skin_core's `HandForceMap`, phases), the [`interaction`]
 //!   periods and the physical contact forces of [`probe`], recorded per cycle in [`record`];
 //! - [`scenario`], [`runner`], [`metrics`], [`outcome`], [`report`]: the named scenarios of the
 //!   papers, a run from scene to report, `metrics.json`, the outcome checks, the summary;
-//! - [`plot`] and [`bag`]: figures in the papers' style and rosbag2 MCAP files; [`outputs`]
+//! - [`plot`]: figures in the papers' style; [`outputs`] (with the `skin_bag` crate's MCAP writer)
 //!   turns a run into `figure.png` and `run.mcap`;
 //! - [`study`]: the speed/accuracy study over control rate, timestep, skin density and the
 //!   inverse's damping (`skin_sim sweep`, `docs/tradeoffs.md`).
 #![warn(missing_docs)]
 
-pub mod bag;
 pub mod base_motion;
 mod cell_face;
 pub mod closed_loop;
 mod frames;
-pub mod hand_force;
 pub mod interaction;
 pub mod lidar;
 pub mod metrics;

@@ -7,10 +7,10 @@ use anyhow::Context;
 use skin_core::resolver::BASE_JOINTS;
 use skin_core::supervisor::Mode;
 
-use crate::bag::msgs::{
+use skin_bag::msgs::{
     Arrangement, Clock, ControllerState, Float64MultiArray, Header, JointState, Time, Twist, Vector3,
 };
-use crate::bag::BagWriter;
+use skin_bag::BagWriter;
 use crate::plot::{guidance_figure, intervals_where, paper000_figure, paper003_figure, GuidanceSignals, Paper000Signals, Paper003Signals};
 use crate::record::{CycleRecord, RunRecord};
 use crate::report::{MetricsJson, RunOutput, RunReport, SummaryText};

@@ -1,8 +1,9 @@
 //! The run record of a closed-loop simulation: one [`CycleRecord`] per control cycle and the
 //! arrangement switches, everything the metrics, the summary, the plots (`skin_sim::plot`) and the
-//! bag writer (`skin_sim::bag`) read. Plain data; nothing in it is computed twice.
+//! bag writer (the `skin_bag` crate) read. Plain data; nothing in it is computed twice.
 
 use skin_core::supervisor::{Mode, SupervisorInput};
+use crate::world::{KeyFrame, World};
 
 /// One control cycle: the measurements the controller got, what it decided and what the
 /// simulation measured at the same instant.
@@ -68,19 +69,6 @@ pub struct Switch {
     pub to: Mode,
 }
 
-/// The simulation's state at one moment of a run, for rendering (`keyframes.json`).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct KeyFrame {
-    /// Simulation time \[s\].
-    pub t_s: f64,
-    /// What happens then (`start`, `end`, a switch `(a) -> (b)`).
-    pub label: String,
-    /// MuJoCo `qpos` (robot joints, movable objects).
-    pub qpos: Vec<f64>,
-    /// MuJoCo `mocap_pos` (persons).
-    pub mocap_pos: Vec<[f64; 3]>,
-}
-
 /// Most key frames one run keeps: the start, the first switches, the end.
 pub const MAX_KEY_FRAMES: usize = 8;
 
@@ -120,7 +108,7 @@ pub struct RunRecord {
 impl RunRecord {
     /// Keeps `world`'s state as a key frame labelled `label` (the last one replaced when full,
     /// so that the end is always kept).
-    pub fn key_frame(&mut self, world: &crate::world::World, label: String) {
+    pub fn key_frame(&mut self, world: &World, label: String) {
         if self.key_frames.len() == MAX_KEY_FRAMES {
             self.key_frames.pop();
         }

@@ -9,7 +9,7 @@ use skin_core::controller::ControllerConfig;
 use skin_core::supervisor::{Mode, SupervisorInput};
 
 use crate::closed_loop::{ClosedLoop, LoopError};
-use crate::hand_force::HandForceMap;
+use skin_core::controller::HandForceMap;
 use crate::interaction::Interactions;
 use crate::metrics::{self, Limits};
 use crate::outcome;

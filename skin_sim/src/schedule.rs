@@ -9,7 +9,7 @@ use skin_core::controller::{Controller, Fault};
 use skin_core::supervisor::{Phase, Policy};
 
 use crate::base_motion::BaseMotions;
-use crate::hand_force::HandForceMap;
+use skin_core::controller::HandForceMap;
 use crate::scene::{ForceReferenceSpec, GoalSpec, Scene};
 
 /// A scene input the controller cannot take.

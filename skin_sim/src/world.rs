@@ -16,8 +16,20 @@ use crate::lidar::Lidar;
 use crate::mjcf::{scene_xml, MjcfError};
 use crate::scene::spec::push_scale;
 use crate::scene::{Scene, SceneError};
-use crate::record::KeyFrame;
 use crate::skin_sensor::{SkinSensor, Touch};
+
+/// The simulation's state at one moment of a run, for rendering (`keyframes.json`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct KeyFrame {
+    /// Simulation time \[s\].
+    pub t_s: f64,
+    /// What happens then (`start`, `end`, a switch `(a) -> (b)`).
+    pub label: String,
+    /// MuJoCo `qpos` (robot joints, movable objects).
+    pub qpos: Vec<f64>,
+    /// MuJoCo `mocap_pos` (persons).
+    pub mocap_pos: Vec<[f64; 3]>,
+}
 
 /// Errors building or driving a [`World`].
 #[derive(Debug, Error)]

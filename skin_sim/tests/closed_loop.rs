@@ -2,7 +2,7 @@
 //! setup, and the outcome checks that hold today (see docs/scenarios.md).
 
 use skin_core::model::{update_kinematics, ModelData};
-use skin_sim::hand_force::HandForceMap;
+use skin_core::controller::HandForceMap;
 use skin_sim::runner::RunTarget;
 use skin_sim::scenario::{self, SCENARIOS};
 use skin_core::supervisor::Mode;

@@ -1,8 +1,8 @@
 //! A run's figure and bag: `figure.png` is a picture of the run, `run.mcap` carries its topics
 //! (every cycle's joint states and commands, the arrangement switches) and reads back.
 
-use skin_sim::bag::msgs::{Arrangement, Float64MultiArray, JointState};
-use skin_sim::bag::read_bag;
+use skin_bag::msgs::{Arrangement, Float64MultiArray, JointState};
+use skin_bag::read_bag;
 use skin_sim::outputs::{FigurePng, KeyFrames, RunBag};
 use skin_sim::report::{write_all, RunOutput};
 use skin_sim::runner::RunTarget;

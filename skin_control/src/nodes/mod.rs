@@ -10,7 +10,6 @@ use anyhow::{Context as _, Result};
 
 use crate::paths;
 
-pub mod mujoco_sim;
 pub mod priority_supervisor;
 pub mod task_controller;
 
@@ -68,6 +67,13 @@ pub fn resolved(node: &r2r::Node, name: &str) -> String {
     }
     let ns = node.namespace().unwrap_or_default();
     format!("{}/{name}", ns.trim_end_matches('/'))
+}
+
+/// `TOPIC=N` of `--wait-topic-subscribers`.
+pub fn topic_count(s: &str) -> Result<(String, usize), String> {
+    let (topic, n) = s.split_once('=').ok_or_else(|| format!("`{s}`: expected TOPIC=N"))?;
+    let n = n.parse().map_err(|e| format!("`{s}`: count `{n}`: {e}"))?;
+    Ok((topic.to_string(), n))
 }
 
 /// A start-up setting: the command-line option, else the ROS parameter `key`, else `default`.
@@ -159,7 +165,7 @@ pub struct SubscriberWait {
     /// matched subscribers in other processes, then print `ready` on stdout; e.g.
     /// `/skin/patches=1` when a recorder must get the first message (a volatile publisher drops
     /// what it sends before discovery has matched a subscriber).
-    #[arg(long, num_args = 1.., value_name = "TOPIC=N", value_parser = crate::rosbag::play::topic_count)]
+    #[arg(long, num_args = 1.., value_name = "TOPIC=N", value_parser = topic_count)]
     pub wait_topic_subscribers: Vec<(String, usize)>,
 }
 

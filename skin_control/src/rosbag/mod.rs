@@ -2,10 +2,10 @@
 //! the messages kept as serialized CDR bytes end to end (r2r's raw subscriptions and untyped
 //! publishers): no field is decoded, so any message type r2r was built with passes unchanged.
 //!
-//! The file format is `skin_sim::bag`'s (profile `ros2`, one `ros2msg` schema per type with the
-//! complete definition of [`skin_sim::bag::full_definition`], one `cdr` channel per topic), read
-//! by rosbags, `ros2 bag` and Foxglove, and written by `skin_sim::bag::BagWriter` itself:
-//! [`RawBagWriter`] only adds the definitions of types skin_sim does not embed (from the ament
+//! The file format is `skin_bag`'s (profile `ros2`, one `ros2msg` schema per type with the
+//! complete definition of [`skin_bag::full_definition`], one `cdr` channel per topic), read
+//! by rosbags, `ros2 bag` and Foxglove, and written by `skin_bag::BagWriter` itself:
+//! [`RawBagWriter`] only adds the definitions of types skin_bag does not embed (from the ament
 //! index) and stores each topic's offered QoS (`offered_qos_profiles`, as rosbag2 does) so that
 //! playback offers the same durability (a latched `/goal` stays latched).
 //!
@@ -17,7 +17,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{bail, Context as _, Result};
-use skin_sim::bag::BagWriter;
+use skin_bag::BagWriter;
 use r2r::qos::{DurabilityPolicy, HistoryPolicy, ReliabilityPolicy};
 use r2r::QosProfile;
 
@@ -170,11 +170,11 @@ impl OfferedQos {
 }
 
 /// The complete `ros2msg` definition of `type_name` (`pkg/msg/Type`), as rosbag2 stores it:
-/// `skin_sim::bag::full_definition` for the graph's types, else composed the same way from the
+/// `skin_bag::full_definition` for the graph's types, else composed the same way from the
 /// `.msg` files of the ament index (`<prefix>/share/<pkg>/msg/<Type>.msg` for each prefix of
 /// `AMENT_PREFIX_PATH`), as rosbag2 finds them.
 pub fn full_definition(type_name: &str) -> Result<String, String> {
-    skin_sim::bag::full_definition(type_name).or_else(|_| {
+    skin_bag::full_definition(type_name).or_else(|_| {
         let prefixes = std::env::var("AMENT_PREFIX_PATH").unwrap_or_default();
         let mut seen = std::collections::BTreeSet::new();
         ament_definition(&type_name.replacen("/msg/", "/", 1), &prefixes, &mut seen)
@@ -209,8 +209,8 @@ fn ament_definition(type_name: &str, prefixes: &str, seen: &mut std::collections
     Ok(out)
 }
 
-/// [`skin_sim::bag::BagWriter`] for serialized messages of types known only at run time: the
-/// definitions come from skin_sim's embedded ones or the ament index ([`full_definition`]).
+/// [`skin_bag::BagWriter`] for serialized messages of types known only at run time: the
+/// definitions come from skin_bag's embedded ones or the ament index ([`full_definition`]).
 pub struct RawBagWriter(BagWriter);
 
 impl RawBagWriter {
@@ -273,7 +273,7 @@ pub struct RawBag {
     pub messages: Vec<RawMessage>,
 }
 
-/// Reads an MCAP bag (uncompressed chunks, as rosbags and `skin_sim::bag` write them).
+/// Reads an MCAP bag (uncompressed chunks, as rosbags and `skin_bag` write them).
 pub fn read_raw(path: &Path) -> Result<RawBag> {
     let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read the bag", path.display()))?;
     let stream = mcap::MessageStream::new(&bytes).with_context(|| format!("{}: not an MCAP file", path.display()))?;

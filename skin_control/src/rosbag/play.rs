@@ -23,6 +23,7 @@ use futures::{FutureExt as _, Stream, StreamExt as _};
 use r2r::rosgraph_msgs::msg::Clock;
 
 use super::{header_stamp, read_raw, step_groups, RawBag};
+use crate::nodes::topic_count;
 use crate::nodes::topics::CLOCK;
 use crate::shutdown;
 
@@ -208,13 +209,6 @@ fn publish_clock(clock: Option<&r2r::Publisher<Clock>>, bag: &RawBag, i: usize) 
         Some(c) => c.publish(&clock_msg(bag.messages[i].log_time_ns)).context(CLOCK),
         None => Ok(()),
     }
-}
-
-/// `TOPIC=N` of `--wait-topic-subscribers`.
-pub(crate) fn topic_count(s: &str) -> Result<(String, usize), String> {
-    let (topic, n) = s.split_once('=').ok_or_else(|| format!("`{s}`: expected TOPIC=N"))?;
-    let n = n.parse().map_err(|e| format!("`{s}`: count `{n}`: {e}"))?;
-    Ok((topic.to_string(), n))
 }
 
 /// Waits until every publisher has its number of inter-process subscribers

@@ -31,7 +31,7 @@ fn header_stamps_are_read_from_stamped_types_only() {
     // A constant before the header is skipped.
     assert_eq!(header_stamp("uint8 MODE=1\nstd_msgs/Header header\n", &data), Some(3_250_000_000));
     assert_eq!(header_stamp(JOINT_STATE, &data[..10]), None, "too short");
-    let full = skin_sim::bag::full_definition("nav_msgs/msg/Odometry").unwrap();
+    let full = skin_bag::full_definition("nav_msgs/msg/Odometry").unwrap();
     assert_eq!(header_stamp(&full, &data), Some(3_250_000_000));
 }
 
@@ -72,7 +72,7 @@ fn raw_bag_round_trips_bytes_types_and_qos() {
 }
 
 #[test]
-fn definitions_outside_skin_sim_come_from_the_ament_index() {
+fn definitions_outside_skin_bag_come_from_the_ament_index() {
     let dir = std::env::temp_dir().join(format!("skin_bag_ament_{}", std::process::id()));
     let msg = dir.join("share/demo_msgs/msg");
     std::fs::create_dir_all(&msg).unwrap();

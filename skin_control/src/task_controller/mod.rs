@@ -21,7 +21,7 @@ use skin_core::model::{frame_pose, update_kinematics, ModelData};
 use skin_core::skin::params::SkinParams;
 use skin_core::supervisor::Mode;
 use skin_core::tasks::params::TaskParams;
-use skin_sim::hand_force::HandForceMap;
+use skin_core::controller::HandForceMap;
 
 use crate::convert::control::{
     imposed_of, split_arms, twist_msg, write_arm_command, write_controller_state, ArmCommand,
@@ -452,7 +452,7 @@ impl TaskController {
     }
 
     /// The hand force reference \[N\], mapped to the hand signal `f_c,d` of paper 003 eq. (9)
-    /// by `skin_sim::hand_force::HandForceMap` (an even contact on the palm cells). Returns the
+    /// by `skin_core::controller::HandForceMap` (an even contact on the palm cells). Returns the
     /// signal given.
     pub fn on_force_reference(&mut self, force_n: f64) -> Result<f64, InputError> {
         let Some(map) = self.hand_map.as_ref() else {

@@ -5,6 +5,7 @@
 //! frames the tasks act on. `docs/controller.md` describes the cycle.
 
 mod cycle;
+mod hand_force;
 mod io;
 mod setup;
 mod task_set;
@@ -13,6 +14,7 @@ mod task_set;
 mod tests;
 
 pub use cycle::Controller;
+pub use hand_force::HandForceMap;
 pub use io::{ControllerInput, ControllerOutput, Fault};
 pub use setup::{ControllerConfig, ControllerSetup, HierarchyDynamics, SetupError};
 pub use task_set::TaskKind;

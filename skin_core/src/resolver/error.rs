@@ -1,6 +1,6 @@
 //! Errors of building and running the torque resolver.
 
-use crate::skin::params::InvalidParam;
+use crate::param_file::InvalidParam;
 
 /// Everything that can go wrong in the resolver. Messages name the input and the offending index
 /// so that a bad cycle can be traced from the log alone. The per-cycle variants carry no heap data.

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::skin::params::{load_validated, parse_validated, InvalidParam, ParamsError};
+use crate::param_file::{load_validated, parse_validated, InvalidParam, ParamsError};
 
 /// All resolver parameters (one YAML file, sections as the fields).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

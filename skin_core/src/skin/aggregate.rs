@@ -10,7 +10,7 @@ use thiserror::Error;
 
 use super::layout::ResolvedLayout;
 use super::live::LiveCells;
-use super::params::InvalidParam;
+use crate::param_file::InvalidParam;
 use super::signals::{CellReading, ForceReduction};
 
 /// A per-cell input slice whose length does not match the layout.

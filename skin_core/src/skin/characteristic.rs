@@ -17,7 +17,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::params::InvalidParam;
+use crate::param_file::InvalidParam;
 
 /// Largest allowed `range_m / decay_m` and `max_n / scale_n`: beyond it the exponential is so
 /// flat at the far end (`exp(-20)` ≈ 2e-9) that signals there are indistinguishable and the

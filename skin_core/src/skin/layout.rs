@@ -24,7 +24,7 @@ use serde_saphyr::Spanned;
 use thiserror::Error;
 
 pub use super::resolved::{ResolvedCell, ResolvedLayout, ResolvedPatch};
-use super::yaml::{self, YamlError};
+use crate::param_file::yaml::{self, YamlError};
 use crate::model::RobotModel;
 
 /// One skin patch: a rigid group of cells on one link, with its own frame {p_j}.

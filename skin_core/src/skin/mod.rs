@@ -27,4 +27,3 @@ pub mod signals;
 pub mod tiling;
 pub mod torques;
 pub mod transforms;
-pub mod yaml;

@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::params::InvalidParam;
+use crate::param_file::InvalidParam;
 
 /// Parameters of the repulsive force laws.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -8,8 +8,8 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::skin::params::InvalidParam;
-use crate::skin::yaml::{self, YamlError};
+use crate::param_file::InvalidParam;
+use crate::param_file::yaml::{self, YamlError};
 
 /// Which switching policy the supervisor runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::skin::params::{load_validated, parse_validated, InvalidParam, ParamsError};
+use crate::param_file::{load_validated, parse_validated, InvalidParam, ParamsError};
 
 /// Paper 000 eq. (7)-(9): goal task gains and speed limit (used for position and orientation).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

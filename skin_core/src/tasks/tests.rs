@@ -11,7 +11,7 @@ use super::contact_reaction::ContactReaction;
 use super::goal::{saturated_goal_force, GoalOrientation, GoalPosition};
 use super::hand_force::{HandForce, HandMeasurement};
 use super::params::TaskParams;
-use crate::skin::params::ParamsError;
+use crate::param_file::ParamsError;
 use super::position_hold::PositionHold;
 use super::posture::{BaseReference, Posture};
 use super::TaskError;

@@ -12,7 +12,7 @@ use skin_core::model::RobotModel;
 use skin_core::resolver::BASE_JOINTS;
 use skin_core::skin::layout::{ResolvedLayout, SkinLayout};
 use skin_core::skin::params::SkinParams;
-use skin_core::skin::yaml::{self, YamlError};
+use skin_core::param_file::yaml::{self, YamlError};
 use thiserror::Error;
 
 use check::{reject, Rejected};

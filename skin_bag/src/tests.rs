@@ -37,7 +37,7 @@ fn float64_after_a_byte_is_aligned_to_8_from_the_payload_start() {
 
 #[test]
 fn every_topic_type_round_trips_through_a_file() {
-    let dir = std::env::temp_dir().join(format!("skin_sim_bag_{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("skin_bag_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("roundtrip.mcap");
 
@@ -105,7 +105,7 @@ fn every_topic_type_round_trips_through_a_file() {
 
 #[test]
 fn a_topic_keeps_its_type_and_errors_name_file_and_topic() {
-    let dir = std::env::temp_dir().join(format!("skin_sim_bag_type_{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("skin_bag_type_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("types.mcap");
     let mut bag = BagWriter::create(&path).unwrap();

@@ -21,10 +21,10 @@ use skin_sim::runner::Decision;
 use skin_sim::scene::Scene;
 use skin_sim::world::World;
 
-use crate::convert::control::{read_arm_command, split_arms, supervisor_input, twist_of, ArmCommand};
-use crate::convert::robot::{base_joints, time_msg, write_goal, write_joint_state, write_odometry, BaseState};
-use crate::convert::write_cell_array;
-use crate::tf::{BASE_FRAME, ODOM_FRAME, WORLD_FRAME};
+use skin_control::convert::control::{read_arm_command, split_arms, supervisor_input, twist_of, ArmCommand};
+use skin_control::convert::robot::{base_joints, time_msg, write_goal, write_joint_state, write_odometry, BaseState};
+use skin_control::convert::write_cell_array;
+use skin_control::tf::{BASE_FRAME, ODOM_FRAME, WORLD_FRAME};
 
 
 /// The messages of one control period, stamped with the simulation time.
@@ -249,7 +249,7 @@ impl SimBridge {
 
     /// The base twist command (held until the next one).
     pub fn on_twist(&mut self, msg: &Twist) -> Result<(), String> {
-        self.twist = twist_of(msg).map_err(|e| format!("{}: {e}", crate::nodes::topics::CMD_VEL))?;
+        self.twist = twist_of(msg).map_err(|e| format!("{}: {e}", skin_control::nodes::topics::CMD_VEL))?;
         Ok(())
     }
 
@@ -286,7 +286,7 @@ fn write_events(layout: &ResolvedLayout, readings: &[CellReading], stamp: &Time,
 /// exactly; returns the applied commands per period.
 pub fn run_in_process(
     bridge: &mut SimBridge,
-    tc: &mut crate::task_controller::TaskController,
+    tc: &mut skin_control::task_controller::TaskController,
     cycles: usize,
 ) -> Vec<AppliedCommand> {
     let mut out = Vec::with_capacity(cycles);
@@ -311,7 +311,7 @@ pub fn run_in_process(
         }
         let _ = tc.on_joint_states(&m.joints, now, |_| {});
         let stamp = tc.ready_stamp().expect("a complete input set every period");
-        let t = crate::convert::robot::time_s(&stamp);
+        let t = skin_control::convert::robot::time_s(&stamp);
         let o = tc.cycle(t, &stamp);
         let arms: Vec<Float64MultiArray> = o.arms.to_vec();
         let twist = o.base.cloned();
@@ -330,8 +330,8 @@ pub fn run_in_process(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ros_params::flatten;
-    use crate::task_controller::{SupervisorSource, TaskController, TaskControllerParams, Trigger};
+    use skin_control::ros_params::flatten;
+    use skin_control::task_controller::{SupervisorSource, TaskController, TaskControllerParams, Trigger};
     use skin_core::controller::ControllerConfig;
     use skin_sim::closed_loop::ClosedLoop;
     use skin_sim::runner::RunTarget;

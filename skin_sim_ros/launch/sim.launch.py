@@ -1,14 +1,16 @@
 """MuJoCo simulation of a scene with the skin control graph.
 
-    ros2 launch skin_control sim.launch.py scene:=intentional_contact
-    ros2 launch skin_control sim.launch.py scene:=tomm_movable_obstacles rviz:=true
-    ros2 launch skin_control sim.launch.py scene:=tactile_guidance namespace:=tomm
+    ros2 launch skin_sim_ros sim.launch.py scene:=intentional_contact
+    ros2 launch skin_sim_ros sim.launch.py scene:=tomm_movable_obstacles rviz:=true
+    ros2 launch skin_sim_ros sim.launch.py scene:=tactile_guidance namespace:=tomm
 
 Starts mujoco_sim (real time, or lockstep:=true), task_controller, priority_supervisor,
 skin_aggregator (all on sim time), robot_state_publisher with the robot's URDF, and RViz on
 request. The robot, its skin layout, the controller setup and whether /scan is an input come from
 the scene (`mujoco_sim --describe`); `setup:=FILE` replaces the scenario's controller setup.
-Every node runs in `namespace` with relative topic names (/clock and /tf stay global)."""
+Every node runs in `namespace` with relative topic names (/clock and /tf stay global). mujoco_sim
+comes from this package, skin_sim_ros; the other nodes, their parameter files and the launch
+helpers (skin_control_launch.py) from the robot package skin_control."""
 import os
 import sys
 
@@ -16,16 +18,17 @@ from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
+from ament_index_python.packages import get_package_share_directory
 
-sys.path.insert(0, os.path.dirname(os.path.realpath(__file__)))
-from skin_control_launch import PKG, describe, graph_nodes  # noqa: E402
+sys.path.insert(0, os.path.join(get_package_share_directory("skin_control"), "launch"))
+from skin_control_launch import SIM_PKG, describe, graph_nodes  # noqa: E402
 
 
 def launch_setup(context):
     arg = lambda name: LaunchConfiguration(name).perform(context)  # noqa: E731
     lockstep = arg("lockstep") == "true"
     description = describe(arg("scene"), arg("setup"))
-    sim = Node(package=PKG, executable="mujoco_sim", name="mujoco_sim", namespace=arg("namespace"),
+    sim = Node(package=SIM_PKG, executable="mujoco_sim", name="mujoco_sim", namespace=arg("namespace"),
                output="screen",
                arguments=["--scene", description["scene"]]
                + (["--lockstep"] if lockstep else ["--realtime-factor", arg("realtime_factor")]))

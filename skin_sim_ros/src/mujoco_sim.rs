@@ -4,7 +4,7 @@
 //! `/tf_static`; `odom -> base_link` on `/tf` when the robot has a base) and the scene's goals
 //! (`/goal`) and force references (`/hand_force_reference`), latched, each sent once a
 //! subscriber is matched (the controller subscribes volatile, as to any user's goal, and gets no
-//! history); applies the arm commands and the base twist. Topic names are relative (`crate::nodes::local`). The
+//! history); applies the arm commands and the base twist. Topic names are relative (`skin_control::nodes::local`). The
 //! scene's `base_motions` are not on the graph yet (a warning says so at start).
 //!
 //! - **lockstep**: publishes the state of period k, waits for one new message on every command
@@ -36,13 +36,14 @@ use r2r::skin_msgs::msg::{Arrangement, ControllerState, SkinCellArray};
 use r2r::std_msgs::msg::{Float64, Float64MultiArray};
 use skin_sim::runner::{ExternalRun, RunTarget};
 
-use super::topics::*;
-use super::{local, Pass};
-use crate::convert::robot::time_msg;
-use crate::qos;
+use skin_control::convert::robot::time_msg;
+use skin_control::nodes::topics::*;
+use skin_control::nodes::{local, Pass};
+use skin_control::qos;
+use skin_control::task_controller::ArmsParams;
+use skin_control::tf::{FrameTransform, TfPublisher, BASE_FRAME, ODOM_FRAME, WORLD_FRAME};
+
 use crate::sim_bridge::{decision, AppliedCommand, SimBridge, SimMessages};
-use crate::task_controller::ArmsParams;
-use crate::tf::{FrameTransform, TfPublisher, BASE_FRAME, ODOM_FRAME, WORLD_FRAME};
 
 /// Node name.
 pub const NODE: &str = "mujoco_sim";
@@ -70,7 +71,7 @@ pub struct Options {
     /// Without it, a first state sent before discovery completes is lost and sent again after
     /// `--resend` (waiting only for the inputs' readers is not enough: the controller's command
     /// and state writers must be matched too).
-    #[arg(long, num_args = 1.., value_name = "TOPIC=N", value_parser = crate::rosbag::play::topic_count)]
+    #[arg(long, num_args = 1.., value_name = "TOPIC=N", value_parser = skin_control::nodes::topic_count)]
     pub wait_topic_subscribers: Vec<(String, usize)>,
     /// Command namespaces, one per arm (default: left_arm right_arm for TOMM, else arm; relative: under the node's namespace).
     #[arg(long = "arm-namespace", value_name = "NS")]
@@ -119,7 +120,7 @@ pub fn describe(scene: &str, setup: Option<PathBuf>) -> Result<serde_json::Value
         "urdf": absolute(&dir.join(&setup.urdf)),
         "layout": absolute(&dir.join(&setup.skin_layout)),
         "lidar": loaded.spec.lidar.is_some(),
-        "base": crate::convert::robot::base_joints(&loaded.model).is_some(),
+        "base": skin_control::convert::robot::base_joints(&loaded.model).is_some(),
         "arms": {"namespaces": arms.namespaces, "joint_prefixes": arms.joint_prefixes},
     }))
 }
@@ -249,7 +250,7 @@ impl SimHandle {
             CLOCK => Some(p.clock.get_inter_process_subscription_count()),
             _ => None,
         };
-        let lacking = super::lacking_subscribers(&self.options.wait_topic_subscribers, count).map_err(|e| {
+        let lacking = skin_control::nodes::lacking_subscribers(&self.options.wait_topic_subscribers, count).map_err(|e| {
             anyhow::anyhow!("--wait-topic-subscribers: {e} (inputs: {JOINT_STATES}, {CELLS}, {ODOM}, {SCAN}, {CLOCK})")
         })?;
         if !lacking.is_empty() && self.started.elapsed() > Duration::from_secs(30) {

@@ -7,8 +7,8 @@
 use std::fmt::Debug;
 
 use anyhow::{bail, ensure, Context, Result};
-use skin_sim::bag::msgs::*;
-use skin_sim::bag::{read_bag, BagMessage, BagWriter, RosMessage};
+use skin_bag::msgs::*;
+use skin_bag::{read_bag, BagMessage, BagWriter, RosMessage};
 
 /// Something done with each sample message: writing it, or checking a bag holds it.
 trait Visit {

@@ -9,7 +9,7 @@ macro_rules! std_msg {
     ($pkg:literal, $ty:literal) => {
         (
             concat!($pkg, "/", $ty),
-            include_str!(concat!("../../assets/ros_msgs/", $pkg, "/", $ty, ".msg")),
+            include_str!(concat!("../assets/ros_msgs/", $pkg, "/", $ty, ".msg")),
         )
     };
 }
@@ -19,7 +19,7 @@ macro_rules! skin_msg {
     ($ty:literal) => {
         (
             concat!("skin_msgs/", $ty),
-            include_str!(concat!("../../../skin_msgs/msg/", $ty, ".msg")),
+            include_str!(concat!("../../skin_msgs/msg/", $ty, ".msg")),
         )
     };
 }

@@ -14,11 +14,11 @@
 //!
 //! and that is the reference this map gives for `F`. The force characteristic is nonlinear, so
 //! an uneven distribution reads lower for the same force: the measured newtons (MuJoCo's
-//! contacts, [`crate::probe`]) tell how good the assumption is.
+//! contacts, measured by skin_sim's probe) tell how good the assumption is.
 
 use nalgebra::Vector3;
-use skin_core::controller::ControllerConfig;
-use skin_core::skin::characteristic::PreparedForce;
+use super::ControllerConfig;
+use crate::skin::characteristic::PreparedForce;
 
 /// A cell counts as facing along the palm normal when `n_i · z_h` exceeds this (within ~25°).
 const FACING_COS: f64 = 0.9;

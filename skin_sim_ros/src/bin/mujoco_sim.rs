@@ -4,7 +4,8 @@ use std::process::ExitCode;
 use anyhow::{Context as _, Result};
 use clap::Parser;
 use futures::executor::LocalPool;
-use skin_control::nodes::{self, mujoco_sim, Pass};
+use skin_control::nodes::{self, Pass};
+use skin_sim_ros::mujoco_sim;
 use skin_control::shutdown;
 
 /// MuJoCo simulation of a scene: publishes /clock, /joint_states, /base/odom, /scan,

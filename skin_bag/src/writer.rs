@@ -37,7 +37,7 @@ impl BagWriter {
         // Uncompressed chunks: every MCAP reader takes them, and the crate needs no C codecs.
         let mcap = mcap::WriteOptions::new()
             .profile("ros2")
-            .library(concat!("skin_sim ", env!("CARGO_PKG_VERSION")))
+            .library(concat!("skin_bag ", env!("CARGO_PKG_VERSION")))
             .compression(None)
             .create(BufWriter::new(file))
             .map_err(|source| BagError::Mcap {

@@ -8,7 +8,8 @@ use anyhow::{Context as _, Result};
 use clap::Parser;
 use futures::executor::LocalPool;
 use r2r::{Parameter, ParameterValue};
-use skin_control::nodes::{self, mujoco_sim, priority_supervisor, task_controller, Pass};
+use skin_control::nodes::{self, priority_supervisor, task_controller, Pass};
+use skin_sim_ros::mujoco_sim;
 use skin_control::shutdown;
 
 /// The skin control graph in one process: task_controller + priority_supervisor (+ mujoco_sim

@@ -1,6 +1,7 @@
-//! rosbag2 MCAP files of the skin_control topics, written without ROS: profile `ros2`, one schema
-//! per message type (encoding `ros2msg`, the complete definition text rosbag2 records), one
-//! channel per topic (message encoding `cdr`), CDR payloads with their encapsulation header.
+//! `skin_bag`: rosbag2 MCAP files of the skin_control topics, written without ROS or MuJoCo
+//! (the robot package and the simulator both write them): profile `ros2`, one schema per message
+//! type (encoding `ros2msg`, the complete definition text rosbag2 records), one channel per topic
+//! (message encoding `cdr`), CDR payloads with their encapsulation header.
 //!
 //! Files open with `ros2 bag`, rosbags, Foxglove and the [`read_bag`] reader used by the tests.
 

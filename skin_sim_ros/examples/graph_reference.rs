@@ -9,7 +9,7 @@
 //! `graph_reference --scene intentional_contact --duration 4 --out ref.json`
 use anyhow::{Context as _, Result};
 use clap::Parser;
-use skin_control::sim_bridge::{run_in_process, SimBridge};
+use skin_sim_ros::sim_bridge::{run_in_process, SimBridge};
 use skin_control::task_controller::{SupervisorSource, TaskController, TaskControllerParams, Trigger};
 use skin_core::controller::ControllerConfig;
 use skin_sim::closed_loop::ClosedLoop;

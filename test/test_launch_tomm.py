@@ -90,11 +90,14 @@ def test_sim_hardware_speaks_the_drivers_topics(launch, rclpy_node):  # noqa: F8
         spin_until(rclpy_node, lambda: ("/", "mujoco_sim") in readers(), 30.0, lambda: f"mujoco_sim reading {topic}: {readers()}")
         spin_until(rclpy_node, lambda: watch.commands[topic], 30.0, f"task_controller's commands on {topic}")
     # ... and applies them: the right arm moves to the scene's goal.
-    spin_until(rclpy_node, lambda: len(joints) > 1, 30.0, "/joint_states")
-    first = dict(zip(joints[0].name, joints[0].position))
+    def right_arm():
+        return [dict(zip(m.name, m.position)) for m in joints if "right_elbow_joint" in m.name]
+
+    spin_until(rclpy_node, lambda: len(right_arm()) > 1, 30.0, "/joint_states with the right arm")
+    first = right_arm()[0]
 
     def moved(prefix):
-        last = dict(zip(joints[-1].name, joints[-1].position))
+        last = right_arm()[-1]
         return max(abs(last[n] - first[n]) for n in first if n.startswith(prefix)) > 1e-2
 
     spin_until(rclpy_node, lambda: moved("right_"), 60.0, "the right arm moving in the simulation")

@@ -6,7 +6,10 @@
   ros_latency probe: a 718-cell /skin/cells at 250 Hz to the right arm's command that uses it;
 - ros_lockstep_realtime_factor: intentional_contact through mujoco_sim --lockstep and
   task_controller (4 s of simulation), two processes on loopback;
-- ros_lockstep_realtime_factor_stack: the same composed in skin_stack (make demo's graph).
+- ros_lockstep_realtime_factor_stack: the same composed in skin_stack (make demo's graph);
+- ros_latency_netns_p50_us, ros_latency_netns_p99_us: the latency with task_controller and the
+  probe on two "hosts" (network namespaces joined by a veth pair, UDPv4, scripts/netns.py); left
+  out, with the reason printed, where namespaces cannot be made (not root).
 
 usage: bench_graph.py TARGET_DIR OUT_JSON   (other figures already in OUT_JSON are kept)"""
 import json
@@ -36,6 +39,28 @@ def latency(bins: Path) -> dict:
     finally:
         stop(tc)
     return json.loads(out.strip().splitlines()[-1])
+
+
+def latency_netns(bins: Path) -> dict:
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from netns import TwoHosts, unavailable
+
+    why = unavailable()
+    if why:
+        print(f"[bench] graph latency across network namespaces left out: {why}")
+        return {}
+    with TwoHosts() as hosts:
+        env = hosts.env()
+        tc = subprocess.Popen(hosts.command("b", [bins / "task_controller", "--setup", "config/controller/tomm.yaml",
+                                                  "--ros-args", "-p", "trigger:=inputs", "-p", "supervisor:=internal"]),
+                              env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            out = subprocess.run(hosts.command("a", [bins / "examples" / "ros_latency", "--periods", "2000"]), env=env,
+                                 check=True, capture_output=True, text=True, timeout=300).stdout
+        finally:
+            stop(tc)
+    figures = json.loads(out.strip().splitlines()[-1])
+    return {k.replace("ros_latency_", "ros_latency_netns_"): v for k, v in figures.items()}
 
 
 def lockstep(bins: Path) -> dict:
@@ -69,7 +94,8 @@ def main() -> int:
         return 2
     bins, out = Path(sys.argv[1]), Path(sys.argv[2])
     summary = json.loads(out.read_text()) if out.is_file() else {}
-    for name, run in (("latency", latency), ("lockstep", lockstep), ("skin_stack lockstep", stack)):
+    for name, run in (("latency", latency), ("latency across network namespaces", latency_netns),
+                      ("lockstep", lockstep), ("skin_stack lockstep", stack)):
         figures = run(bins)
         print(f"[bench] graph {name}: {figures}")
         summary.update(figures)

@@ -145,3 +145,45 @@ def cell_array(entries, stamp=None):
     if stamp is not None:
         msg.header.stamp = stamp
     return msg
+
+
+def ros2_or_skip():
+    """The `ros2` command line with the launch system, or skip the test saying how to get it."""
+    import shutil
+
+    exe = shutil.which("ros2")
+    probe = exe and subprocess.run([exe, "launch", "--help"], capture_output=True).returncode == 0
+    if not probe:
+        pytest.skip("needs the ROS 2 Jazzy command line (`ros2 launch`): on a robot source "
+                    "/opt/ros/jazzy/setup.bash; here set ROS2_PYTHON_TOOLS to a directory with the "
+                    "upstream launch/ros2cli sources and their `install` script, then re-run scripts/bootstrap")
+    return exe
+
+
+@pytest.fixture(scope="session")
+def ament_prefix(tmp_path_factory):
+    """skin_control and skin_sim_ros installed as `colcon build` installs them (cargo-ament-build's
+    layout: the ament index markers, share/<pkg>/{package.xml, launch, ...}, lib/<pkg>/<bins>),
+    copied from the repository, the binaries linked to the build under test; returns the
+    environment that puts the prefix first on AMENT_PREFIX_PATH, for `ros2 launch <pkg> ...`."""
+    import shutil
+
+    prefix = tmp_path_factory.mktemp("install")
+    index = prefix / "share" / "ament_index" / "resource_index" / "packages"
+    index.mkdir(parents=True)
+    packages = {"skin_control": (["launch", "config", "urdf"], ["task_controller", "priority_supervisor", "skin_aggregator"]),
+                "skin_sim_ros": (["skin_sim_ros/launch"], ["mujoco_sim"])}
+    for pkg, (dirs, exes) in packages.items():
+        (index / pkg).write_text("")
+        share = prefix / "share" / pkg
+        share.mkdir()
+        (share / "package.xml").symlink_to(TOP / pkg / "package.xml")
+        for d in dirs:
+            shutil.copytree(TOP / d, share / d.rsplit("/", 1)[-1])
+        lib = prefix / "lib" / pkg
+        lib.mkdir(parents=True)
+        for exe in exes:
+            (lib / exe).symlink_to(binary(exe))
+    env = dict(os.environ)
+    env["AMENT_PREFIX_PATH"] = f"{prefix}:{env.get('AMENT_PREFIX_PATH', '')}"
+    return env

@@ -219,7 +219,10 @@ def test_graph_survives_faults(spawn, rclpy_node):
     goal.header.frame_id = "world"
     goal.pose.position.x, goal.pose.position.y, goal.pose.position.z = 0.6, -0.5, 1.0
     goal.pose.orientation.w = 1.0
-    rclpy_node.create_publisher(PoseStamped, "/goal", LATCHED).publish(goal)
+    # The controller reads goals volatile (REP 2003): send once its reader is matched.
+    goal_pub = rclpy_node.create_publisher(PoseStamped, "/goal", LATCHED)
+    spin_until(rclpy_node, lambda: goal_pub.get_subscription_count() > 0, 30.0, "the controller's /goal reader")
+    goal_pub.publish(goal)
 
     def states(*phases):
         return in_phase(got["/controller/state"], *phases)

@@ -17,3 +17,4 @@ pub mod rosbag;
 pub mod shutdown;
 pub mod supervisor_node;
 pub mod task_controller;
+pub mod tf;

@@ -1,4 +1,6 @@
-//! QoS profiles used across the nodes, named for what they carry.
+//! QoS profiles used across the nodes, named for what they carry. Publishers offer reliable
+//! delivery; subscriptions ask for no more than their input needs (REP 2003), so that a driver's
+//! best-effort sensor stream (SensorDataQoS) and an ordinary volatile goal publisher match.
 use r2r::QosProfile;
 
 /// Streams of sensor data and commands: reliable, a short history (a late sample is worth less
@@ -14,6 +16,22 @@ pub fn stream() -> QosProfile {
 /// one sample per spin, so the reader history is the only buffer.
 pub fn every_sample() -> QosProfile {
     QosProfile::default().reliable().keep_last(1000)
+}
+
+/// Sensor inputs (joint states, odometry, scan, skin cells): best effort, which matches both
+/// best-effort (REP 2003's SensorDataQoS) and reliable publishers. A sample lost in transport
+/// is not resent (the next one replaces it; the lockstep simulator resends a period that got no
+/// answer). `depth`: the reader history, as in [`stream`] or [`every_sample`].
+pub fn sensor_input(depth: usize) -> QosProfile {
+    QosProfile::default().best_effort().keep_last(depth)
+}
+
+/// Commands and references a user sends (goals, force references): reliable and volatile,
+/// which matches volatile publishers (`ros2 topic pub`, RViz's goal tool) and latched ones alike
+/// (a volatile reader gets no history: a latched publisher's sample sent before it joined is
+/// not delivered, so the simulator repeats the active goal).
+pub fn user_input() -> QosProfile {
+    QosProfile::default().reliable().volatile().keep_last(10)
 }
 
 /// State that a late joiner must still get (the active arrangement): reliable, transient local.

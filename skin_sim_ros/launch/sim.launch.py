@@ -1,55 +1,54 @@
 """MuJoCo simulation of a scene with the skin control graph.
 
-    ros2 launch skin_sim_ros sim.launch.py scene:=intentional_contact setup:=config/controller/planar7.yaml
+    ros2 launch skin_sim_ros sim.launch.py scene:=intentional_contact
     ros2 launch skin_sim_ros sim.launch.py scene:=tomm_movable_obstacles rviz:=true
+    ros2 launch skin_sim_ros sim.launch.py scene:=tactile_guidance namespace:=tomm
 
 Starts mujoco_sim (real time, or lockstep:=true), task_controller, priority_supervisor,
-skin_aggregator (all on sim time), robot_state_publisher with our URDF, and RViz on request.
-Paths are relative to the skin_control share directory (the nodes also look there); mujoco_sim
-comes from this package, skin_sim_ros, the other nodes from the robot package skin_control."""
+skin_aggregator (all on sim time), robot_state_publisher with the robot's URDF, and RViz on
+request. The robot, its skin layout, the controller setup and whether /scan is an input come from
+the scene (`mujoco_sim --describe`); `setup:=FILE` replaces the scenario's controller setup.
+Every node runs in `namespace` with relative topic names (/clock and /tf stay global). mujoco_sim
+comes from this package, skin_sim_ros; the other nodes, their parameter files and the launch
+helpers (skin_control_launch.py) from the robot package skin_control."""
+import os
+import sys
+
 from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument
-from launch.conditions import IfCondition
-from launch.substitutions import LaunchConfiguration, PythonExpression
+from launch.actions import DeclareLaunchArgument, OpaqueFunction
+from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
-from launch_ros.substitutions import FindPackageShare
-from launch.substitutions import PathJoinSubstitution
+from ament_index_python.packages import get_package_share_directory
 
-PKG = "skin_control"
-SIM_PKG = "skin_sim_ros"
+sys.path.insert(0, os.path.join(get_package_share_directory("skin_control"), "launch"))
+from skin_control_launch import SIM_PKG, describe, graph_nodes  # noqa: E402
 
 
-def share(*parts):
-    return PathJoinSubstitution([FindPackageShare(PKG), *parts])
+def launch_setup(context):
+    arg = lambda name: LaunchConfiguration(name).perform(context)  # noqa: E731
+    lockstep = arg("lockstep") == "true"
+    description = describe(arg("scene"), arg("setup"))
+    sim = Node(package=SIM_PKG, executable="mujoco_sim", name="mujoco_sim", namespace=arg("namespace"),
+               output="screen",
+               arguments=["--scene", description["scene"]]
+               + (["--lockstep"] if lockstep else ["--realtime-factor", arg("realtime_factor")]))
+    return [sim] + graph_nodes(arg("namespace"), description, sim_time=True,
+                               trigger="inputs" if lockstep else "timer")
 
 
 def generate_launch_description():
-    scene = LaunchConfiguration("scene")
-    setup = LaunchConfiguration("setup")
-    urdf = LaunchConfiguration("urdf")
-    lockstep = LaunchConfiguration("lockstep")
-    sim_time = {"use_sim_time": True}
     return LaunchDescription([
         DeclareLaunchArgument("scene", default_value="tomm_movable_obstacles",
-                              description="scenario name or scene file (config/scenes/)"),
-        DeclareLaunchArgument("setup", default_value="config/controller/tomm.yaml",
-                              description="controller setup file (the scene's robot)"),
-        DeclareLaunchArgument("urdf", default_value="urdf/tomm.urdf", description="robot URDF for robot_state_publisher"),
-        DeclareLaunchArgument("lockstep", default_value="false", description="reproducible lockstep simulation"),
+                              description="scenario name (skin_sim list) or scene file"),
+        DeclareLaunchArgument("setup", default_value="",
+                              description="controller setup file (default: the scenario's)"),
+        DeclareLaunchArgument("namespace", default_value="", description="namespace of every node"),
+        DeclareLaunchArgument("lockstep", default_value="false",
+                              description="reproducible lockstep simulation (controller trigger:=inputs)"),
+        DeclareLaunchArgument("realtime_factor", default_value="1.0",
+                              description="real-time mode: simulated seconds per wall-clock second"),
+        DeclareLaunchArgument("robot_state_publisher", default_value="true",
+                              description="start robot_state_publisher (TF of the robot's links)"),
         DeclareLaunchArgument("rviz", default_value="false", description="start RViz with config/skin.rviz"),
-        Node(package=SIM_PKG, executable="mujoco_sim", name="mujoco_sim", output="screen",
-             arguments=["--scene", scene,
-                        PythonExpression(["'--lockstep' if '", lockstep, "' == 'true' else '--realtime-factor=1'"])]),
-        Node(package=PKG, executable="task_controller", name="task_controller", output="screen",
-             parameters=[share("config", "ros", "task_controller.yaml"), sim_time,
-                         {"setup_file": setup,
-                          "trigger": PythonExpression(["'inputs' if '", lockstep, "' == 'true' else 'timer'"])}]),
-        Node(package=PKG, executable="priority_supervisor", name="priority_supervisor", output="screen",
-             parameters=[share("config", "ros", "priority_supervisor.yaml"), sim_time, {"setup_file": setup}]),
-        Node(package=PKG, executable="skin_aggregator", name="skin_aggregator", output="screen",
-             parameters=[share("config", "ros", "skin_aggregator.yaml"), sim_time]),
-        Node(package="robot_state_publisher", executable="robot_state_publisher", output="screen",
-             parameters=[sim_time, {"robot_description": PythonExpression(["open('", share(urdf), "').read()"])}]),
-        Node(package="rviz2", executable="rviz2", arguments=["-d", share("config", "skin.rviz")],
-             parameters=[sim_time], condition=IfCondition(LaunchConfiguration("rviz"))),
+        OpaqueFunction(function=launch_setup),
     ])

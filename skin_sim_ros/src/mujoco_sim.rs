@@ -1,8 +1,11 @@
-//! `mujoco_sim`: a scene's MuJoCo world on the graph. Publishes `/clock`, `/joint_states`,
-//! `/base/odom`, `/scan`, `/skin/cells` (every one stamped with the simulation time of the
-//! period) and the scene's goals (`/goal`, latched) and force references
-//! (`/hand_force_reference`, latched); applies the arm commands and the base twist. The scene's
-//! `base_motions` are not on the graph yet (a warning says so at start).
+//! `mujoco_sim`: a scene's MuJoCo world on the graph, speaking the robot drivers' topics.
+//! Publishes `/clock`, `/joint_states`, `/base/odom`, `/scan`, `/skin/cells` (every one stamped
+//! with the simulation time of the period), TF as the drivers do (`world -> odom` on
+//! `/tf_static`; `odom -> base_link` on `/tf` when the robot has a base) and the scene's goals
+//! (`/goal`) and force references (`/hand_force_reference`), latched, each sent once a
+//! subscriber is matched (the controller subscribes volatile, as to any user's goal, and gets no
+//! history); applies the arm commands and the base twist. Topic names are relative (`skin_control::nodes::local`). The
+//! scene's `base_motions` are not on the graph yet (a warning says so at start).
 //!
 //! - **lockstep**: publishes the state of period k, waits for one new message on every command
 //!   topic, applies them, steps one control period. The run is a function of the scene, like the
@@ -33,12 +36,14 @@ use r2r::skin_msgs::msg::{Arrangement, ControllerState, SkinCellArray};
 use r2r::std_msgs::msg::{Float64, Float64MultiArray};
 use skin_sim::runner::{ExternalRun, RunTarget};
 
-use skin_control::nodes::topics::*;
-use skin_control::nodes::Pass;
 use skin_control::convert::robot::time_msg;
+use skin_control::nodes::topics::*;
+use skin_control::nodes::{local, Pass};
 use skin_control::qos;
-use crate::sim_bridge::{decision, AppliedCommand, SimBridge, SimMessages};
 use skin_control::task_controller::ArmsParams;
+use skin_control::tf::{FrameTransform, TfPublisher, BASE_FRAME, ODOM_FRAME, WORLD_FRAME};
+
+use crate::sim_bridge::{decision, AppliedCommand, SimBridge, SimMessages};
 
 /// Node name.
 pub const NODE: &str = "mujoco_sim";
@@ -68,7 +73,7 @@ pub struct Options {
     /// and state writers must be matched too).
     #[arg(long, num_args = 1.., value_name = "TOPIC=N", value_parser = skin_control::nodes::topic_count)]
     pub wait_topic_subscribers: Vec<(String, usize)>,
-    /// Command namespaces, one per arm (default: /left_arm /right_arm for TOMM, else /arm).
+    /// Command namespaces, one per arm (default: left_arm right_arm for TOMM, else arm; relative: under the node's namespace).
     #[arg(long = "arm-namespace", value_name = "NS")]
     pub arm_namespaces: Vec<String>,
     /// Joint-name prefix per arm, pairs with --arm-namespace (default: left_ right_, else "").
@@ -96,6 +101,28 @@ pub fn scene_file(arg: &str) -> Result<PathBuf> {
 /// The controller setup of a scenario (None: a scene file that is not a scenario's).
 pub fn scenario_setup(arg: &str) -> Option<PathBuf> {
     RunTarget::resolve(arg, None).ok().map(|t| t.controller)
+}
+
+/// What a launch file needs to start the rest of the graph for `scene` (a scenario name or a
+/// scene file): the controller setup (the scenario's, or `setup`), the URDF and skin layout it
+/// names, whether the scene has a LIDAR (the controller's `use_scan`) and the robot a base, and
+/// the arms' command namespaces and joint prefixes. Paths are absolute.
+pub fn describe(scene: &str, setup: Option<PathBuf>) -> Result<serde_json::Value> {
+    let target = RunTarget::resolve(scene, setup).map_err(|e| anyhow::anyhow!("--scene: {e}"))?;
+    let loaded = skin_sim::scene::Scene::load(&target.scene).with_context(|| format!("--scene {scene}"))?;
+    let (setup, _) = skin_core::controller::ControllerSetup::load(&target.controller).with_context(|| target.controller.display().to_string())?;
+    let dir = target.controller.parent().unwrap_or(std::path::Path::new("."));
+    let absolute = |p: &std::path::Path| std::fs::canonicalize(p).or_else(|_| std::path::absolute(p)).unwrap_or_else(|_| p.to_path_buf());
+    let arms = ArmsParams::for_joints(loaded.model.joint_names());
+    Ok(serde_json::json!({
+        "scene": absolute(&target.scene),
+        "setup": absolute(&target.controller),
+        "urdf": absolute(&dir.join(&setup.urdf)),
+        "layout": absolute(&dir.join(&setup.skin_layout)),
+        "lidar": loaded.spec.lidar.is_some(),
+        "base": skin_control::convert::robot::base_joints(&loaded.model).is_some(),
+        "arms": {"namespaces": arms.namespaces, "joint_prefixes": arms.joint_prefixes},
+    }))
 }
 
 struct Pubs {
@@ -147,6 +174,11 @@ pub struct SimHandle {
     last_force: Option<f64>,
     recorder: Option<Recorder>,
     progress_s: f64,
+    /// `/tf` and `/tf_static` (None: built without tf2_msgs).
+    tf: Option<TfPublisher>,
+    /// The scene's goal and force reference due but not sent yet: no subscriber was matched.
+    pending_goal: Option<PoseStamped>,
+    pending_force: Option<f64>,
 }
 
 /// The controller's sensor inputs of one period, joint states last: the controller's input set is
@@ -170,15 +202,40 @@ impl SimHandle {
         let m = self.bridge.messages();
         self.pubs.clock.publish(&m.clock).context(CLOCK)?;
         if let Some(g) = &m.goal {
-            self.pubs.goal.publish(g).context(GOAL)?;
+            self.pending_goal = Some(g.clone());
         }
         if m.force_n != self.last_force {
-            if let Some(f) = m.force_n {
-                self.pubs.force.publish(&Float64 { data: f }).context(FORCE_REFERENCE)?;
-            }
+            self.pending_force = m.force_n;
             self.last_force = m.force_n;
         }
-        publish_inputs(&self.pubs, m)
+        self.send_references()?;
+        publish_inputs(&self.pubs, self.bridge.last_messages())?;
+        self.publish_base_tf()
+    }
+
+    /// `odom -> base_link` on `/tf` with the period's stamp, as a base driver sends it.
+    fn publish_base_tf(&self) -> Result<()> {
+        if let (Some(tf), Some(pose)) = (&self.tf, self.bridge.base_pose()) {
+            let t = FrameTransform { parent: ODOM_FRAME.into(), child: BASE_FRAME.into(), pose };
+            tf.send(&[t], &time_msg(self.bridge.world().time())).context(TF)?;
+        }
+        Ok(())
+    }
+
+    /// Sends the pending goal and force reference whose topic has a subscriber now.
+    fn send_references(&mut self) -> Result<()> {
+        fn matched<T: r2r::WrappedTypesupport + 'static>(p: &r2r::Publisher<T>, topic: &'static str) -> Result<bool> {
+            p.get_inter_process_subscription_count().context(topic).map(|n| n > 0)
+        }
+        if self.pending_goal.is_some() && matched(&self.pubs.goal, GOAL)? {
+            let g = self.pending_goal.take().expect("checked");
+            self.pubs.goal.publish(&g).context(GOAL)?;
+        }
+        if self.pending_force.is_some() && matched(&self.pubs.force, FORCE_REFERENCE)? {
+            let f = self.pending_force.take().expect("checked");
+            self.pubs.force.publish(&Float64 { data: f }).context(FORCE_REFERENCE)?;
+        }
+        Ok(())
     }
 
     /// Whether a topic of `--wait-topic-subscribers` still lacks subscribers (false after 30 s,
@@ -207,7 +264,8 @@ impl SimHandle {
         // The same messages again (the goal only if it is the period's; force unchanged).
         let m = self.bridge.last_messages();
         self.pubs.clock.publish(&m.clock).context(CLOCK)?;
-        publish_inputs(&self.pubs, m)
+        publish_inputs(&self.pubs, m)?;
+        self.publish_base_tf()
     }
 
     /// Takes the commands in the inbox into the bridge; in lockstep only when every topic has a
@@ -293,6 +351,9 @@ impl SimHandle {
     /// One pass of the spin loop: [`Pass::Busy`] when it published, [`Pass::Done`] when the run
     /// is over.
     pub fn poll(&mut self) -> Result<Pass> {
+        if self.pending_goal.is_some() || self.pending_force.is_some() {
+            self.send_references()?;
+        }
         let t = self.bridge.world().time();
         if self.options.lockstep {
             let Some(sent) = self.sent_at else {
@@ -411,16 +472,28 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
     let end_s = options.duration.unwrap_or(bridge.duration_s());
     let pubs = Pubs {
         clock: node.create_publisher(CLOCK, qos::stream())?,
-        joints: node.create_publisher(JOINT_STATES, qos::stream())?,
-        odom: node.create_publisher(ODOM, qos::stream())?,
-        scan: node.create_publisher(SCAN, qos::stream())?,
-        cells: node.create_publisher(CELLS, qos::stream())?,
-        goal: node.create_publisher(GOAL, qos::latched())?,
-        force: node.create_publisher(FORCE_REFERENCE, qos::latched())?,
+        joints: node.create_publisher(local(JOINT_STATES), qos::stream())?,
+        odom: node.create_publisher(local(ODOM), qos::stream())?,
+        scan: node.create_publisher(local(SCAN), qos::stream())?,
+        cells: node.create_publisher(local(CELLS), qos::stream())?,
+        goal: node.create_publisher(local(GOAL), qos::latched())?,
+        force: node.create_publisher(local(FORCE_REFERENCE), qos::latched())?,
+    };
+    let tf = match TfPublisher::new(node)? {
+        Ok(tf) => {
+            // The controller's world is the odometry frame (its base joints are the odometry).
+            let fixed = FrameTransform { parent: WORLD_FRAME.into(), child: ODOM_FRAME.into(), pose: nalgebra::Isometry3::identity() };
+            tf.send_static(&[fixed], &time_msg(0.0)).context(TF_STATIC)?;
+            Some(tf)
+        }
+        Err(why) => {
+            r2r::log_warn!(&logger, "{why}");
+            None
+        }
     };
     let inbox = Rc::new(RefCell::new(Inbox { arms: vec![None; bridge.arms().len()], twist: None, state: None, fusion_weight: f64::NAN, errors: 0 }));
     for (k, arm) in bridge.arms().iter().enumerate() {
-        let mut sub = node.subscribe::<Float64MultiArray>(&arm.topic, qos::stream())?;
+        let mut sub = node.subscribe::<Float64MultiArray>(local(&arm.topic), qos::stream())?;
         let inbox = inbox.clone();
         spawner.spawn_local(async move {
             while let Some(m) = sub.next().await {
@@ -429,7 +502,7 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
         })?;
     }
     if bridge.has_base() {
-        let mut sub = node.subscribe::<Twist>(CMD_VEL, qos::stream())?;
+        let mut sub = node.subscribe::<Twist>(local(CMD_VEL), qos::stream())?;
         let inbox = inbox.clone();
         spawner.spawn_local(async move {
             while let Some(m) = sub.next().await {
@@ -467,6 +540,9 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
         recorder,
         progress_s: end_s / 10.0,
         options,
+        tf,
+        pending_goal: None,
+        pending_force: None,
     })
 }
 
@@ -480,14 +556,14 @@ fn start_recorder(options: &Options, scene: skin_sim::scene::Scene, bridge: &Sim
 /// `--out`: `/controller/state` (the period's answer) and `/supervisor/arrangement` (its
 /// fusion weight) into the inbox.
 fn subscribe_controller(node: &mut r2r::Node, spawner: &LocalSpawner, inbox: &Rc<RefCell<Inbox>>) -> Result<()> {
-    let mut states = node.subscribe::<ControllerState>(CONTROLLER_STATE, qos::stream())?;
+    let mut states = node.subscribe::<ControllerState>(local(CONTROLLER_STATE), qos::stream())?;
     let states_inbox = inbox.clone();
     spawner.spawn_local(async move {
         while let Some(m) = states.next().await {
             states_inbox.borrow_mut().state = Some(m);
         }
     })?;
-    let mut arrangements = node.subscribe::<Arrangement>(ARRANGEMENT, qos::latched())?;
+    let mut arrangements = node.subscribe::<Arrangement>(local(ARRANGEMENT), qos::latched())?;
     let inbox = inbox.clone();
     spawner.spawn_local(async move {
         while let Some(m) = arrangements.next().await {

@@ -24,9 +24,8 @@ use skin_sim::world::World;
 use skin_control::convert::control::{read_arm_command, split_arms, supervisor_input, twist_of, ArmCommand};
 use skin_control::convert::robot::{base_joints, time_msg, write_goal, write_joint_state, write_odometry, BaseState};
 use skin_control::convert::write_cell_array;
+use skin_control::tf::{BASE_FRAME, ODOM_FRAME, WORLD_FRAME};
 
-/// Odometry frame of `/base/odom`.
-pub const ODOM_FRAME: &str = "odom";
 
 /// The messages of one control period, stamped with the simulation time.
 #[derive(Debug, Clone, Default)]
@@ -173,6 +172,15 @@ impl SimBridge {
         self.base.is_some()
     }
 
+    /// The pose of [`BASE_FRAME`] in [`ODOM_FRAME`] (None: no base): the transform a base driver
+    /// publishes on `/tf`.
+    pub fn base_pose(&self) -> Option<Isometry3<f64>> {
+        let q = self.world.q();
+        self.base.map(|[x, y, yaw]| {
+            Isometry3::from_parts(Translation3::new(q[x], q[y], 0.0), UnitQuaternion::from_euler_angles(0.0, 0.0, q[yaw]))
+        })
+    }
+
     /// The end time of the scene \[s\].
     pub fn duration_s(&self) -> f64 {
         self.world.scene().spec.duration_s
@@ -195,7 +203,7 @@ impl SimBridge {
         m.odom = self.base.map(|[x, y, yaw]| {
             let mut o = m.odom.take().unwrap_or_default();
             let b = BaseState { q: [w.q()[x], w.q()[y], w.q()[yaw]], qd: [w.qd()[x], w.qd()[y], w.qd()[yaw]] };
-            write_odometry(&b, &stamp, ODOM_FRAME, "base_link", &mut o);
+            write_odometry(&b, &stamp, ODOM_FRAME, BASE_FRAME, &mut o);
             o
         });
         m.scan = match (&self.scan_geometry, w.lidar()) {
@@ -226,7 +234,7 @@ impl SimBridge {
             if *start > t + 0.5 * self.period_s {
                 break;
             }
-            m.goal = Some(write_goal(pose, &stamp, "world"));
+            m.goal = Some(write_goal(pose, &stamp, WORLD_FRAME));
             self.next_goal += 1;
         }
         let forces = &w.scene().spec.force_references;

@@ -10,18 +10,17 @@ use r2r::skin_msgs::msg::PatchWrenchArray;
 use r2r::visualization_msgs::msg::MarkerArray;
 use r2r::{ParameterValue, RosParams};
 use skin_control::aggregator::{Aggregator, SKIN_PARAM_DESCRIPTIONS};
-use skin_control::convert::IssueKind;
+use skin_control::convert::{patch_frame_id, IssueKind};
 use skin_control::ros_params::StructParams;
+use skin_control::nodes::topics::{CELLS as CELLS_TOPIC, MARKERS as MARKERS_TOPIC, PATCHES as PATCHES_TOPIC};
 use skin_control::nodes::{self, file_setting, resolve};
+use skin_control::tf::{FrameTransform, TfPublisher};
 use skin_control::{markers, qos, shutdown};
 use skin_core::model::RobotModel;
 use skin_core::skin::layout::{ResolvedLayout, SkinLayout};
 use skin_core::skin::params::SkinParams;
 
 const NODE: &str = "skin_aggregator";
-const CELLS_TOPIC: &str = "/skin/cells";
-const PATCHES_TOPIC: &str = "/skin/patches";
-const MARKERS_TOPIC: &str = "/skin/markers";
 
 /// Aggregates skin cells (/skin/cells, skin_msgs/SkinCellArray) into patch wrenches
 /// (/skin/patches, skin_msgs/PatchWrenchArray) and RViz markers (/skin/markers).
@@ -136,9 +135,25 @@ fn main() -> Result<()> {
         .make_derived_parameter_handler(served)
         .context("declaring the parameters")?;
     // Read from the serialized bytes (convert::cdr_cells: no C message per message).
-    let mut cells = node.subscribe_raw(CELLS_TOPIC, nodes::topics::CELLS_TYPE, qos::every_sample())?;
-    let patches_pub = node.create_publisher::<PatchWrenchArray>(PATCHES_TOPIC, qos::stream())?;
-    let markers_pub = node.create_publisher::<MarkerArray>(MARKERS_TOPIC, qos::stream())?;
+    let mut cells = node.subscribe_raw(nodes::local(CELLS_TOPIC), nodes::topics::CELLS_TYPE, qos::sensor_input(1000))?;
+    let patches_pub = node.create_publisher::<PatchWrenchArray>(nodes::local(PATCHES_TOPIC), qos::stream())?;
+    let markers_pub = node.create_publisher::<MarkerArray>(nodes::local(MARKERS_TOPIC), qos::stream())?;
+    // The patch frames {p_j} that /skin/patches is expressed in, fixed in their links.
+    let _patch_frames = match TfPublisher::new(&mut node)? {
+        Ok(tf) => {
+            let frames: Vec<FrameTransform> = layout
+                .patches()
+                .iter()
+                .map(|p| FrameTransform { parent: p.link.clone(), child: patch_frame_id(p.id), pose: p.link_from_patch })
+                .collect();
+            tf.send_static(&frames, &r2r::builtin_interfaces::msg::Time::default()).context(nodes::topics::TF_STATIC)?;
+            Some(tf)
+        }
+        Err(why) => {
+            r2r::log_warn!(&logger, "{why} (the patch frames skin_patch_<id> of {PATCHES_TOPIC})");
+            None
+        }
+    };
     r2r::log_info!(
         &logger,
         "{} -> {}, {}: layout {} ({} patches, {} cells)",

@@ -13,7 +13,11 @@ use crate::paths;
 pub mod priority_supervisor;
 pub mod task_controller;
 
-/// Topic names of the graph (docs/ros.md).
+/// Topic names of the graph (docs/ros.md), as they resolve in the root namespace (logs and the
+/// counters of `/controller/state` use these). The nodes create their publishers and
+/// subscriptions with the relative name ([`local`]), so that a node namespace
+/// (`__ns:=/tomm`, a launch file's `namespace`) and remapping apply; `/clock` and `/tf*` stay
+/// global, as in every ROS 2 node (rcl's time source subscribes `/clock`, tf2 `/tf`).
 pub mod topics {
     /// Skin cells (skin_msgs/SkinCellArray).
     pub const CELLS: &str = "/skin/cells";
@@ -21,6 +25,8 @@ pub mod topics {
     pub const CELLS_TYPE: &str = "skin_msgs/msg/SkinCellArray";
     /// Patch wrenches (skin_msgs/PatchWrenchArray).
     pub const PATCHES: &str = "/skin/patches";
+    /// Skin markers for RViz (visualization_msgs/MarkerArray).
+    pub const MARKERS: &str = "/skin/markers";
     /// Joint states (sensor_msgs/JointState).
     pub const JOINT_STATES: &str = "/joint_states";
     /// Base odometry (nav_msgs/Odometry).
@@ -39,8 +45,28 @@ pub mod topics {
     pub const ARRANGEMENT: &str = "/supervisor/arrangement";
     /// Phase service (skin_msgs/srv/SetPhase).
     pub const SET_PHASE: &str = "/supervisor/set_phase";
-    /// Simulation clock (rosgraph_msgs/Clock).
+    /// Simulation clock (rosgraph_msgs/Clock): global.
     pub const CLOCK: &str = "/clock";
+    /// Transforms (tf2_msgs/TFMessage): global.
+    pub const TF: &str = "/tf";
+    /// Fixed transforms (tf2_msgs/TFMessage, transient local): global.
+    pub const TF_STATIC: &str = "/tf_static";
+}
+
+/// The name a node creates its entity with: `topic` relative (without the leading `/`), so that
+/// the node's namespace and remapping rules apply. Global names ([`topics::CLOCK`],
+/// [`topics::TF`]) are passed as they are.
+pub fn local(topic: &str) -> &str {
+    topic.strip_prefix('/').unwrap_or(topic)
+}
+
+/// `name` as it resolves in `node`'s namespace (for logs; remapping rules are not applied).
+pub fn resolved(node: &r2r::Node, name: &str) -> String {
+    if name.starts_with('/') {
+        return name.to_string();
+    }
+    let ns = node.namespace().unwrap_or_default();
+    format!("{}/{name}", ns.trim_end_matches('/'))
 }
 
 /// `TOPIC=N` of `--wait-topic-subscribers`.

@@ -74,12 +74,12 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     let sup = PrioritySupervisor::new(&config.supervisor, ros_now(node)).map_err(|e| anyhow::anyhow!("{setup}: supervisor: {e}"))?;
     r2r::log_info!(&logger, "{setup}: policy {:?}, {CONTROLLER_STATE} -> {ARRANGEMENT}, service {SET_PHASE}", sup.supervisor().policy());
     let sup = Rc::new(RefCell::new(sup));
-    let publisher = node.create_publisher::<Arrangement>(ARRANGEMENT, qos::latched())?;
+    let publisher = node.create_publisher::<Arrangement>(super::local(ARRANGEMENT), qos::latched())?;
     let initial = sup.borrow().current();
     publisher.publish(&initial).context(ARRANGEMENT)?;
     sup.borrow_mut().published(&initial);
 
-    let mut states = node.subscribe::<ControllerState>(CONTROLLER_STATE, qos::every_sample())?;
+    let mut states = node.subscribe::<ControllerState>(super::local(CONTROLLER_STATE), qos::every_sample())?;
     let (s, p, log) = (sup.clone(), publisher.clone(), logger.clone());
     spawner.spawn_local(async move {
         while let Some(msg) = states.next().await {
@@ -106,7 +106,7 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
         }
     })?;
 
-    let mut service = node.create_service::<SetPhase::Service>(SET_PHASE, qos::services())?;
+    let mut service = node.create_service::<SetPhase::Service>(super::local(SET_PHASE), qos::services())?;
     let (s, log) = (sup.clone(), logger.clone());
     spawner.spawn_local(async move {
         while let Some(req) = service.next().await {

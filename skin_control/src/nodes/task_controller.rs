@@ -18,7 +18,7 @@ use r2r::{ParameterValue, RosParams};
 use skin_core::controller::ControllerConfig;
 
 use super::topics::*;
-use super::{file_setting, resolve, ros_now, OnceLog, Timing};
+use super::{file_setting, local, resolve, resolved, ros_now, OnceLog, Timing};
 use crate::convert::robot::time_msg;
 use crate::qos;
 use crate::ros_params::StructParams;
@@ -205,13 +205,14 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     let tc = TaskController::new(config, initial.clone(), ros_now(node)).map_err(|e| anyhow::anyhow!("{setup}: {e}"))?;
     let topics: Vec<String> = tc.arms().iter().map(|a| a.topic.clone()).collect();
     let pubs = Publishers {
-        arms: topics.iter().map(|t| node.create_publisher::<Float64MultiArray>(t, qos::stream())).collect::<r2r::Result<_>>()?,
-        base: if tc.has_base() { Some(node.create_publisher::<Twist>(CMD_VEL, qos::stream())?) } else { None },
-        state: node.create_publisher::<ControllerState>(CONTROLLER_STATE, qos::stream())?,
+        arms: topics.iter().map(|t| node.create_publisher::<Float64MultiArray>(local(t), qos::stream())).collect::<r2r::Result<_>>()?,
+        base: if tc.has_base() { Some(node.create_publisher::<Twist>(local(CMD_VEL), qos::stream())?) } else { None },
+        state: node.create_publisher::<ControllerState>(local(CONTROLLER_STATE), qos::stream())?,
     };
-    let mut all_topics = topics.clone();
+    // The command topics as resolved in the node's namespace, for the log and subscriber counts.
+    let mut all_topics: Vec<String> = topics.iter().map(|t| resolved(node, t)).collect();
     if tc.has_base() {
-        all_topics.push(CMD_VEL.into());
+        all_topics.push(resolved(node, local(CMD_VEL)));
     }
     r2r::log_info!(
         &logger,
@@ -242,7 +243,7 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
         }
     })?;
 
-    let js = node.subscribe::<JointState>(JOINT_STATES, qos::stream())?;
+    let js = node.subscribe::<JointState>(local(JOINT_STATES), qos::sensor_input(10))?;
     spawn_sub(spawner, js, &shared, |s, msg| {
         let now = s.now();
         let Shared { tc, logger, .. } = &mut *s;
@@ -252,14 +253,14 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
         s.refused(result);
     })?;
     if shared.borrow().tc.has_base() {
-        let odom = node.subscribe::<Odometry>(ODOM, qos::stream())?;
+        let odom = node.subscribe::<Odometry>(local(ODOM), qos::sensor_input(10))?;
         spawn_sub(spawner, odom, &shared, |s, msg| {
             let result = s.tc.on_odometry(&msg, s.now());
             s.refused(result);
         })?;
     }
     // Read from the serialized bytes (convert::cdr_cells: the largest input, on the latency path).
-    let cells = node.subscribe_raw(CELLS, CELLS_TYPE, qos::every_sample())?;
+    let cells = node.subscribe_raw(local(CELLS), CELLS_TYPE, qos::sensor_input(1000))?;
     spawn_sub(spawner, cells, &shared, |s, msg| {
         let now = s.now();
         let Shared { tc, logger, .. } = &mut *s;
@@ -269,23 +270,23 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
         s.refused(result);
     })?;
     if initial.use_scan {
-        let scan = node.subscribe::<LaserScan>(SCAN, qos::stream())?;
+        let scan = node.subscribe::<LaserScan>(local(SCAN), qos::sensor_input(10))?;
         spawn_sub(spawner, scan, &shared, |s, msg| {
             let result = s.tc.on_scan(&msg, s.now());
             s.refused(result);
         })?;
     }
-    let goal = node.subscribe::<PoseStamped>(GOAL, qos::latched())?;
+    let goal = node.subscribe::<PoseStamped>(local(GOAL), qos::user_input())?;
     spawn_sub(spawner, goal, &shared, |s, msg| match s.tc.on_goal(&msg) {
         Ok(()) => r2r::log_info!(&s.logger, "{GOAL}: goal ({:.3}, {:.3}, {:.3})", msg.pose.position.x, msg.pose.position.y, msg.pose.position.z),
         Err(e) => s.refused(Err(e)),
     })?;
-    let force = node.subscribe::<Float64>(FORCE_REFERENCE, qos::latched())?;
+    let force = node.subscribe::<Float64>(local(FORCE_REFERENCE), qos::user_input())?;
     spawn_sub(spawner, force, &shared, |s, msg| {
         let result = s.tc.on_force_reference(msg.data).map(|_| ());
         s.refused(result);
     })?;
-    let arrangement = node.subscribe::<Arrangement>(ARRANGEMENT, qos::latched())?;
+    let arrangement = node.subscribe::<Arrangement>(local(ARRANGEMENT), qos::latched())?;
     spawn_sub(spawner, arrangement, &shared, |s, msg| match s.tc.on_arrangement(&msg) {
         Ok(true) => r2r::log_info!(&s.logger, "{ARRANGEMENT}: following mode {} {:?}", msg.mode, msg.task_order),
         Ok(false) => {}

@@ -8,7 +8,7 @@
 //! reference (newtons), `/supervisor/arrangement`. A cycle runs only on a complete input set
 //! (every required input received at least once); until then, and whenever the inputs go stale,
 //! the commands are zero.
-use nalgebra::Vector2;
+use nalgebra::{Isometry3, Vector2};
 use r2r::builtin_interfaces::msg::Time;
 use r2r::geometry_msgs::msg::{PoseStamped, Twist};
 use r2r::nav_msgs::msg::Odometry;
@@ -17,6 +17,7 @@ use r2r::skin_msgs::msg::{Arrangement as ArrangementMsg, ControllerState};
 use r2r::std_msgs::msg::Float64MultiArray;
 use serde::{Deserialize, Serialize};
 use skin_core::controller::{Controller, ControllerConfig, ControllerInput};
+use skin_core::model::{frame_pose, update_kinematics, ModelData};
 use skin_core::skin::params::SkinParams;
 use skin_core::supervisor::Mode;
 use skin_core::tasks::params::TaskParams;
@@ -30,6 +31,7 @@ use crate::convert::cdr_cells::CdrCells;
 use crate::convert::{update_cells, CellBuffer, CellMessage, Issue, IssueKind};
 use crate::input_health::{IssueTable, StampGate, StampIssue};
 use crate::nodes::topics::{ARRANGEMENT, CELLS, FORCE_REFERENCE, GOAL, JOINT_STATES, ODOM, SCAN};
+use crate::tf::{ODOM_FRAME, WORLD_FRAME};
 
 /// What starts a control cycle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -61,21 +63,22 @@ pub enum SupervisorSource {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ArmsParams {
-    /// Command namespaces, e.g. `[/left_arm, /right_arm]`.
+    /// Command namespaces, e.g. `[left_arm, right_arm]` (relative: under the node's namespace;
+    /// an absolute one, `/left_arm`, is not).
     pub namespaces: Vec<String>,
     /// Joint-name prefixes, e.g. `[left_, right_]` (an empty prefix takes every other joint).
     pub joint_prefixes: Vec<String>,
 }
 
 impl ArmsParams {
-    /// The default split for these joints: `/left_arm` and `/right_arm` by `left_`/`right_`
-    /// when both exist (TOMM), else one arm `/arm` with every arm joint.
+    /// The default split for these joints: `left_arm` and `right_arm` by `left_`/`right_`
+    /// when both exist (TOMM), else one arm `arm` with every arm joint.
     pub fn for_joints(names: &[String]) -> Self {
         let two = ["left_", "right_"].iter().all(|p| names.iter().any(|n| n.starts_with(p)));
         if two {
-            ArmsParams { namespaces: vec!["/left_arm".into(), "/right_arm".into()], joint_prefixes: vec!["left_".into(), "right_".into()] }
+            ArmsParams { namespaces: vec!["left_arm".into(), "right_arm".into()], joint_prefixes: vec!["left_".into(), "right_".into()] }
         } else {
-            ArmsParams { namespaces: vec!["/arm".into()], joint_prefixes: vec![String::new()] }
+            ArmsParams { namespaces: vec!["arm".into()], joint_prefixes: vec![String::new()] }
         }
     }
 }
@@ -420,10 +423,32 @@ impl TaskController {
         self.scan.update(msg).map_err(self.health.refuse(SCAN))
     }
 
-    /// `/goal`: the end-effector goal in the world frame.
+    /// `/goal`: the end-effector goal in the frame `header.frame_id` names: `world` or `odom`
+    /// (the same frame here: the base joints are the odometry pose), or any link of the URDF
+    /// (`base_link`, a hand, ...), taken at the measured state when the goal arrives. Any other
+    /// frame is refused (and counted).
     pub fn on_goal(&mut self, msg: &PoseStamped) -> Result<(), InputError> {
         let pose = goal_pose(msg).map_err(self.health.refuse(GOAL))?;
-        self.controller.set_goal(Some(pose)).map_err(|f| self.health.refuse(GOAL)(f.to_string()))
+        let frame = self.frame_in_world(&msg.header.frame_id).map_err(self.health.refuse(GOAL))?;
+        self.controller.set_goal(Some(frame * pose)).map_err(|f| self.health.refuse(GOAL)(f.to_string()))
+    }
+
+    /// The world pose of frame `name` at the measured state.
+    fn frame_in_world(&self, name: &str) -> Result<Isometry3<f64>, String> {
+        if name == WORLD_FRAME || name == ODOM_FRAME {
+            return Ok(Isometry3::identity());
+        }
+        let model = &self.controller.config().model;
+        let Some(frame) = model.frame_index(name) else {
+            return Err(format!("header.frame_id `{name}`: not {WORLD_FRAME}, {ODOM_FRAME} or a link of the robot's URDF"));
+        };
+        if !self.state.complete() {
+            let missing = self.missing().join(", ");
+            return Err(format!("header.frame_id `{name}`: the robot's state is not known yet (waiting for {missing})"));
+        }
+        let mut data = ModelData::new(model);
+        update_kinematics(model, &mut data, self.state.q(), self.state.qd()).map_err(|e| format!("header.frame_id `{name}`: {e}"))?;
+        Ok(*frame_pose(&data, frame))
     }
 
     /// The hand force reference \[N\], mapped to the hand signal `f_c,d` of paper 003 eq. (9)

@@ -26,6 +26,10 @@ use skin_control::shutdown;
 struct Args {
     #[command(flatten)]
     options: mujoco_sim::Options,
+    /// Print what the launch files need for --scene (controller setup, URDF, skin layout, LIDAR,
+    /// base, arm namespaces; --controller overrides the setup) as JSON, and exit.
+    #[arg(long)]
+    describe: bool,
 }
 
 fn main() -> ExitCode {
@@ -34,6 +38,10 @@ fn main() -> ExitCode {
 
 fn run() -> Result<Option<bool>> {
     let args = Args::parse_from(nodes::cli_args());
+    if args.describe {
+        println!("{}", mujoco_sim::describe(&args.options.scene, args.options.controller.clone())?);
+        return Ok(None);
+    }
     shutdown::install().context("installing the SIGINT/SIGTERM handler")?;
     let ctx = r2r::Context::create()?;
     let mut node = r2r::Node::create(ctx, mujoco_sim::NODE, "")?;

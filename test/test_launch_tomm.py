@@ -1,0 +1,124 @@
+"""launch/tomm.launch.py. hardware:=sim through the real `ros2 launch`: mujoco_sim reads the two
+arms' commands in the drivers' namespaces, the controller runs on its topics, the arm moves. hardware:=real
+needs ur_robot_driver and ros2_control (C++, not installable here): its per-arm settings are
+checked as data (own namespace, controller manager, tf_prefix, ports; the velocity controller's
+joints are what task_controller commands there)."""
+import importlib.util
+import xml.etree.ElementTree as ET
+
+import pytest
+import yaml
+
+from conftest import TOP, spin_until
+from test_launch_sim import Watch, describe, launch  # noqa: F401 (the fixture)
+
+
+def tomm_launch_module():
+    pytest.importorskip("launch_ros", reason="needs the ROS 2 launch system (see conftest.ros2_or_skip)")
+    spec = importlib.util.spec_from_file_location("tomm_launch", TOP / "launch" / "tomm.launch.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def defaults(module):
+    """The launch arguments' default values (the plain-text ones)."""
+    from launch.actions import DeclareLaunchArgument
+
+    out = {}
+    for a in module.generate_launch_description().entities:
+        if isinstance(a, DeclareLaunchArgument) and all(hasattr(s, "text") for s in a.default_value):
+            out[a.name] = "".join(s.text for s in a.default_value)
+    return out
+
+
+def texts(node):
+    """The plain-text words of a launch Node's command line."""
+    return ["".join(s.text for s in part) for part in node.cmd if all(hasattr(s, "text") for s in part)]
+
+
+def test_real_arms_have_their_own_namespace_manager_prefix_and_ports(ament_prefix, monkeypatch):
+    monkeypatch.setenv("AMENT_PREFIX_PATH", ament_prefix["AMENT_PREFIX_PATH"])
+    from launch.launch_context import LaunchContext
+    from launch.utilities import perform_substitutions
+    from launch_ros.actions import Node, PushRosNamespace
+
+    m = tomm_launch_module()
+    args = defaults(m)
+    arms = m.arms(args.__getitem__)
+    assert [a["namespace"] for a in arms] == ["left_arm", "right_arm"]
+    ports = [int(a[p]) for a in arms for p in m.PORTS]
+    assert len(set(ports)) == len(ports) == 8, f"ports shared between the drivers: {ports}"
+
+    urdf = ET.parse(TOP / "urdf" / "tomm.urdf").getroot()
+    movable = [j.get("name") for j in urdf.findall("joint") if j.get("type") in ("revolute", "continuous")]
+    controllers = (TOP / "config" / "ros" / "ur_controllers.yaml").read_text()
+    ctx = LaunchContext()
+    for arm in arms:
+        # The velocity controller's joints, with the arm's tf_prefix, are the URDF's joints of that
+        # arm in model order: the order task_controller writes its command in.
+        joints = yaml.safe_load(controllers.replace("$(var tf_prefix)", arm["tf_prefix"]))
+        joints = joints["/**/forward_velocity_controller"]["ros__parameters"]["joints"]
+        assert joints == [j for j in movable if j.startswith(arm["tf_prefix"])], joints
+        group = m.ur_driver(arm, "", args.__getitem__)
+        actions = group.get_sub_entities()
+        (push,) = [a for a in actions if isinstance(a, PushRosNamespace)]
+        assert perform_substitutions(ctx, push.namespace) == arm["namespace"]
+        spawners = [texts(a) for a in actions if isinstance(a, Node) and "spawner" in str(a.node_executable)]
+        (spawn,) = spawners
+        assert spawn[spawn.index("--controller-manager") + 1] == f"/{arm['namespace']}/controller_manager"
+        assert "forward_velocity_controller" in spawn and "joint_state_broadcaster" in spawn
+    # The command topics task_controller publishes to are the ones these controllers serve.
+    d = describe("tomm_movable_obstacles")
+    assert d["arms"]["namespaces"] == [a["namespace"] for a in arms]
+    assert d["arms"]["joint_prefixes"] == [a["tf_prefix"] for a in arms]
+
+
+def test_sim_hardware_speaks_the_drivers_topics(launch, rclpy_node):  # noqa: F811
+    from sensor_msgs.msg import JointState
+
+    d = describe("tomm_movable_obstacles")
+    watch = Watch(rclpy_node, "", d)
+    joints = []
+    rclpy_node.create_subscription(JointState, "/joint_states", joints.append, 100)
+    la = launch("skin_control", "tomm.launch.py", "hardware:=sim", "robot_state_publisher:=false")
+    la.wait_for(rclpy_node, lambda: watch.fresh(20), "20 fresh controller states")
+    # The simulator takes each arm's commands where its driver would (the arm's namespace) ...
+    for ns in ("left_arm", "right_arm"):
+        topic = f"/{ns}/forward_velocity_controller/commands"
+        readers = lambda: {(i.node_namespace, i.node_name) for i in rclpy_node.get_subscriptions_info_by_topic(topic)}  # noqa: E731
+        spin_until(rclpy_node, lambda: ("/", "mujoco_sim") in readers(), 30.0, lambda: f"mujoco_sim reading {topic}: {readers()}")
+        spin_until(rclpy_node, lambda: watch.commands[topic], 30.0, f"task_controller's commands on {topic}")
+    # ... and applies them: the right arm moves to the scene's goal.
+    def right_arm():
+        return [dict(zip(m.name, m.position)) for m in joints if "right_elbow_joint" in m.name]
+
+    spin_until(rclpy_node, lambda: len(right_arm()) > 1, 30.0, "/joint_states with the right arm")
+    first = right_arm()[0]
+
+    def moved(prefix):
+        last = right_arm()[-1]
+        return max(abs(last[n] - first[n]) for n in first if n.startswith(prefix)) > 1e-2
+
+    spin_until(rclpy_node, lambda: moved("right_"), 60.0, "the right arm moving in the simulation")
+    watch.commands_only()
+    rc, alive = la.interrupt()
+    assert not alive and rc == 0 and "has died" not in la.output(), la.output()[-3000:]
+    spin_until(rclpy_node, watch.last_commands_zero, 10.0, "zero commands last")
+
+
+@pytest.mark.parametrize("scene", ["intentional_contact", "tomm_movable_obstacles", "tactile_guidance"])
+def test_the_real_robot_path_reads_a_setup_as_the_controller_does(scene, ament_prefix, monkeypatch):
+    """hardware:=real takes the URDF and skin layout from the controller setup without a scene
+    (skin_control_launch.setup_files, following `base` files): the same files mujoco_sim
+    --describe resolves through skin_core for the scenario's setup."""
+    import os
+    import sys
+
+    monkeypatch.setenv("AMENT_PREFIX_PATH", ament_prefix["AMENT_PREFIX_PATH"])
+    pytest.importorskip("launch_ros", reason="needs the ROS 2 launch system (see conftest.ros2_or_skip)")
+    sys.path.insert(0, str(TOP / "launch"))
+    from skin_control_launch import setup_files
+
+    d = describe(scene)
+    assert tuple(map(os.path.realpath, setup_files(d["setup"]))) == (d["urdf"], d["layout"])

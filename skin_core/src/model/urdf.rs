@@ -417,7 +417,9 @@ fn check_mass_matrix(ctx: &Ctx<'_>, model: &RobotModel, robot: &Urdf, moving: &[
         let diag = m.diagonal();
         for k in (0..n).rev() {
             let pivot = m[(k, k)];
-            if !(pivot > 1e-12 * diag[k]) || diag[k] <= 1e-14 * scale {
+            // NaN pivots (overflowing inputs) count as singular too
+            let singular = pivot.is_nan() || pivot <= 1e-12 * diag[k] || diag[k] <= 1e-14 * scale;
+            if singular {
                 let b = model.bodies.iter().position(|b| b.coord == k).unwrap_or(k);
                 let j = &robot.joints[moving[b]];
                 return Err(ctx.invalid(

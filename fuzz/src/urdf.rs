@@ -1,6 +1,6 @@
 //! Arbitrary text as URDF into the robot model parser. Checked: no panic; a model that loads is
-//! consistent (one name, limit and axis per joint, `lower <= upper`, unit axes, finite positive
-//! body masses) and its kinematics and dynamics run without panicking.
+//! consistent (one name, limit and axis per joint, `lower <= upper`, unit axes, finite
+//! non-negative body masses) and its kinematics and dynamics run without panicking.
 
 use nalgebra::{DMatrix, DVector};
 use skin_core::model::{crba, gravity, update_kinematics, ModelData, RobotModel};
@@ -19,9 +19,10 @@ fn check_model(m: &RobotModel) {
             "joint {}: axis",
             m.joint_names()[j]
         );
+        // massless bodies are allowed when their descendants make M positive definite
         let mass = m.body_mass(j);
         assert!(
-            mass.is_finite() && mass > 0.0,
+            mass.is_finite() && mass >= 0.0,
             "joint {}: body mass {mass}",
             m.joint_names()[j]
         );

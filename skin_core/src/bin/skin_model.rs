@@ -11,7 +11,8 @@ use nalgebra::{DMatrix, DVector, Matrix6xX, Vector3, Vector6};
 use serde::Deserialize;
 use serde_json::{json, Value};
 use skin_core::model::{
-    bias_forces, crba, gravity, point_jacobian, point_jacobian_dot_qdot, update_kinematics, ModelData, RobotModel,
+    bias_forces, crba, gravity, point_jacobian, point_jacobian_dot_qdot, update_kinematics, MimicMode, ModelData, RobotModel,
+    UrdfOptions,
 };
 
 /// Evaluate kinematics and dynamics of a URDF robot model and print one JSON document.
@@ -20,15 +21,22 @@ use skin_core::model::{
 /// (C(q,q̇)q̇ + g(q)), "gravity" (g(q)); with --link also "jacobian" (6 rows of n, world axes,
 /// linear rows first, for the point given in the link frame) and "jacobian_dot_qdot" (6, the
 /// classical acceleration of that point and the angular acceleration for q̈ = 0).
-/// Gravity is 9.81 m/s² along world -z.
+/// Gravity is 9.81 m/s² along world -z. What loading repaired or accepted with reservations
+/// (inertias) is printed to stderr as warnings naming the link; docs/dynamics.md ("Loading any
+/// URDF") has the rules.
 #[derive(Parser, Debug)]
 #[command(name = "skin_model", version, about, long_about)]
 struct Args {
     /// URDF file (plain URDF, no xacro).
     #[arg(long, value_name = "FILE")]
     urdf: PathBuf,
+    /// Mimic joints: `independent` (each its own joint and coordinate, the <mimic> element
+    /// ignored: pinocchio's default) or `follow` (q = multiplier * q_leader + offset, no
+    /// coordinate of its own: pinocchio's mimic=True).
+    #[arg(long, value_enum, default_value_t = Mimic::Independent)]
+    mimic: Mimic,
     /// Joint positions, comma separated, in model order (see "joints" in the output).
-    #[arg(long, value_name = "V1,V2,...", allow_hyphen_values = true, required_unless_present = "batch")]
+    #[arg(long, value_name = "V1,V2,...", allow_hyphen_values = true, required_unless_present_any = ["batch", "joints"])]
     q: Option<String>,
     /// Joint velocities, comma separated (default: zeros).
     #[arg(long, value_name = "V1,V2,...", allow_hyphen_values = true)]
@@ -43,6 +51,16 @@ struct Args {
     /// ("qd", "link", "point" optional); prints a JSON list of result objects.
     #[arg(long, value_name = "STATES.json", conflicts_with_all = ["q", "qd", "link", "point"])]
     batch: Option<PathBuf>,
+    /// Print the names of the generalized coordinates (the order of q) as a JSON list and exit.
+    #[arg(long, conflicts_with_all = ["q", "qd", "link", "point", "batch"])]
+    joints: bool,
+}
+
+/// `--mimic` values (see [`MimicMode`]).
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum Mimic {
+    Independent,
+    Follow,
 }
 
 /// One state of batch mode.
@@ -147,7 +165,17 @@ impl<'a> Evaluator<'a> {
 }
 
 fn run(args: Args) -> Result<Value> {
-    let model = RobotModel::from_urdf_file(&args.urdf)?;
+    let mimic = match args.mimic {
+        Mimic::Independent => MimicMode::Independent,
+        Mimic::Follow => MimicMode::Follow,
+    };
+    let model = RobotModel::from_urdf_file_with(&args.urdf, &UrdfOptions { mimic })?;
+    for w in model.warnings() {
+        eprintln!("skin_model: warning: {}: {w}", model.source());
+    }
+    if args.joints {
+        return Ok(json!(model.joint_names()));
+    }
     let mut ev = Evaluator::new(&model);
     if let Some(batch) = &args.batch {
         let text = std::fs::read_to_string(batch).with_context(|| format!("cannot read {}", batch.display()))?;

@@ -34,36 +34,38 @@ pub fn update_kinematics(model: &RobotModel, data: &mut ModelData, q: &[f64], qd
     // is far from the world origin. The trunk (bodies 0..=ref_body, a single chain) is posed
     // first to find that point; positions relative to it are then accumulated from the reference
     // body outwards, so they do not carry the rounding of large world coordinates.
-    let n = model.nv();
-    if n == 0 {
+    if model.njoints() == 0 {
         return Ok(());
     }
-    for (i, &qi) in q.iter().enumerate().take(model.ref_body + 1) {
-        pose_body(model, data, i, qi);
+    for i in 0..=model.ref_body {
+        pose_body(model, data, i, joint_value(&model.bodies[i], q));
     }
     data.ref_point = data.body_pos[model.ref_body];
     let r0 = data.ref_point;
     for (i, b) in model.bodies.iter().enumerate() {
+        let qi = joint_value(b, q);
         if i > model.ref_body {
-            pose_body(model, data, i, q[i]);
+            pose_body(model, data, i, qi);
         }
         let a = data.axis_w[i];
         let rel = match b.parent {
             Some(p) if !model.trunk[i] => {
                 let mut rel = data.body_rel[p] + data.body_rot[p] * b.placement.translation.vector;
                 if b.kind == JointKind::Prismatic {
-                    rel += a * q[i];
+                    rel += a * qi;
                 }
                 rel
             }
             _ => data.body_pos[i] - r0,
         };
         data.body_rel[i] = rel;
+        // motion subspace per unit of the driving coordinate (a followed mimic joint moves
+        // `multiplier` times its leader's rate)
         let s = match b.kind {
             JointKind::Revolute => svec(&a, &rel.cross(&a)),
             JointKind::Prismatic => svec(&Vector3::zeros(), &a),
-        };
-        let vj = s * qd[i];
+        } * b.multiplier;
+        let vj = s * qd[b.coord];
         let (vp, ap) = match b.parent {
             Some(p) => (data.v[p], data.a_bias[p]),
             None => (SVec::zeros(), SVec::zeros()),
@@ -86,6 +88,12 @@ pub fn update_kinematics(model: &RobotModel, data: &mut ModelData, q: &[f64], qd
         }
     }
     Ok(())
+}
+
+/// Value of a moving joint from the generalized coordinates.
+#[inline(always)]
+fn joint_value(b: &super::Body, q: &[f64]) -> f64 {
+    b.multiplier * q[b.coord] + b.offset
 }
 
 /// World pose, rotation matrix and axis of body `i` from its parent's (parents come first).
@@ -168,16 +176,19 @@ pub fn point_jacobian(
     o.fill(0.0);
     let mut k = model.frames[frame].body;
     while let Some(j) = k {
-        let a = &data.axis_w[j];
-        let col = &mut o[6 * j..6 * j + 6];
-        match model.bodies[j].kind {
+        let b = &model.bodies[j];
+        let a = data.axis_w[j] * b.multiplier;
+        let col = &mut o[6 * b.coord..6 * b.coord + 6];
+        // accumulated: the joints that follow one coordinate add up
+        let add = |col: &mut [f64], v: [f64; 6]| col.iter_mut().zip(v).for_each(|(c, v)| *c += v);
+        match b.kind {
             JointKind::Revolute => {
                 let l = a.cross(&(p - data.body_pos[j]));
-                col.copy_from_slice(&[l[0], l[1], l[2], a[0], a[1], a[2]]);
+                add(col, [l[0], l[1], l[2], a[0], a[1], a[2]]);
             }
-            JointKind::Prismatic => col.copy_from_slice(&[a[0], a[1], a[2], 0.0, 0.0, 0.0]),
+            JointKind::Prismatic => add(col, [a[0], a[1], a[2], 0.0, 0.0, 0.0]),
         }
-        k = model.bodies[j].parent;
+        k = b.parent;
     }
     Ok(())
 }
@@ -208,7 +219,7 @@ pub fn point_jacobian_along(
     out.fill(0.0);
     let mut k = model.frames[frame].body;
     while let Some(j) = k {
-        out[j] = data.s[j].dot(&force);
+        out[model.bodies[j].coord] += data.s[j].dot(&force);
         k = model.bodies[j].parent;
     }
     Ok(())

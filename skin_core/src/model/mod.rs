@@ -3,7 +3,9 @@
 //! [`RobotModel`] is a kinematic tree of one-degree-of-freedom joints (revolute, continuous,
 //! prismatic) built from a URDF; links joined by fixed joints are merged into the moving body
 //! they hang from, and every URDF link stays available as a *frame* with a constant placement in
-//! that body (like pinocchio's frames). [`ModelData`] holds everything the algorithms compute;
+//! that body (like pinocchio's frames). Mimic joints are independent joints (pinocchio's
+//! default) or follow their leader (one generalized coordinate), see [`UrdfOptions`]; the rules
+//! of loading are in docs/dynamics.md, "Loading any URDF". [`ModelData`] holds everything the algorithms compute;
 //! after [`ModelData::new`] no function of this module allocates.
 //!
 //! Typical use:
@@ -19,10 +21,12 @@
 
 mod crba;
 mod error;
+mod inertia_check;
 mod kinematics;
 mod rnea;
 pub mod spatial;
 mod urdf;
+mod urdf_xml;
 
 #[cfg(test)]
 mod tests;
@@ -108,6 +112,26 @@ pub struct Collision {
     pub shape: Shape,
 }
 
+/// How mimic joints (`<mimic joint multiplier offset>`) enter the model.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MimicMode {
+    /// Every mimic joint is an independent joint with its own coordinate; the `<mimic>` element
+    /// is ignored (pinocchio's default, `buildModelFromUrdf(..., mimic=False)`).
+    #[default]
+    Independent,
+    /// A mimic joint follows its leader: `q_joint = multiplier · q_leader + offset`, no coordinate
+    /// of its own; the Jacobian and mass matrix are composed accordingly (pinocchio's
+    /// `mimic=True`). The leader's coordinate keeps the leader's name and limits.
+    Follow,
+}
+
+/// Options of URDF loading.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct UrdfOptions {
+    /// Mimic joints: independent (default) or following their leader.
+    pub mimic: MimicMode,
+}
+
 /// One moving body: a 1-DoF joint and everything rigidly attached after it.
 #[derive(Clone, Debug)]
 pub(crate) struct Body {
@@ -119,6 +143,11 @@ pub(crate) struct Body {
     pub(crate) axis: Vector3<f64>,
     /// Joint frame at q = 0 in the parent body frame (or the world).
     pub(crate) placement: Isometry3<f64>,
+    /// Generalized coordinate that drives the joint: joint value = `multiplier · q[coord] + offset`
+    /// (coord = own index, 1, 0 unless a followed mimic joint).
+    pub(crate) coord: usize,
+    pub(crate) multiplier: f64,
+    pub(crate) offset: f64,
     /// Merged inertia of the body: mass, centre of mass and inertia about it, body frame.
     pub(crate) mass: f64,
     pub(crate) com: Vector3<f64>,
@@ -137,12 +166,23 @@ pub(crate) struct Frame {
 
 /// Immutable robot model built from a URDF. Joint order ("model order") is depth-first from the
 /// root link, children in document order; it is the order of every q, q̇, τ vector.
+///
+/// Two index spaces: the *moving joints* of the tree (`0..njoints()`, the `joint_*` structure
+/// accessors and [`ModelData`]'s per-joint poses) and the *generalized coordinates*
+/// (`0..nv()`, every q, q̇, τ, Jacobian column, and [`RobotModel::joint_names`]). They are the
+/// same unless mimic joints follow their leaders ([`MimicMode::Follow`]); then
+/// [`RobotModel::joint_coordinate`] maps one to the other.
 #[derive(Clone, Debug)]
 pub struct RobotModel {
     pub(crate) name: String,
     pub(crate) source: String,
     pub(crate) bodies: Vec<Body>,
+    /// Names of the generalized coordinates (their driving joints).
     pub(crate) joint_names: Vec<String>,
+    /// Names of all moving joints, in tree order.
+    pub(crate) moving_joint_names: Vec<String>,
+    /// What loading repaired or accepted with reservations (one line each, naming the link).
+    pub(crate) warnings: Vec<String>,
     pub(crate) limits: Vec<JointLimits>,
     pub(crate) frames: Vec<Frame>,
     pub(crate) frame_names: Vec<String>,
@@ -155,16 +195,33 @@ pub struct RobotModel {
 }
 
 impl RobotModel {
-    /// Loads and validates a URDF file (plain URDF, no xacro).
+    /// Loads and validates a URDF file (plain URDF, no xacro) with the default options.
     pub fn from_urdf_file(path: &std::path::Path) -> Result<RobotModel, ModelError> {
-        let file = path.display().to_string();
-        let xml = std::fs::read_to_string(path).map_err(|io| ModelError::Io { file: file.clone(), io })?;
-        Self::from_urdf_str(&xml, &file)
+        Self::from_urdf_file_with(path, &UrdfOptions::default())
     }
 
-    /// Loads and validates URDF text; `source` names it (usually the file) in error messages.
+    /// Loads and validates a URDF file with the given options.
+    pub fn from_urdf_file_with(path: &std::path::Path, options: &UrdfOptions) -> Result<RobotModel, ModelError> {
+        let file = path.display().to_string();
+        let xml = std::fs::read_to_string(path).map_err(|io| ModelError::Io { file: file.clone(), io })?;
+        Self::from_urdf_str_with(&xml, &file, options)
+    }
+
+    /// Loads and validates URDF text with the default options; `source` names it (usually the
+    /// file) in error messages.
     pub fn from_urdf_str(xml: &str, source: &str) -> Result<RobotModel, ModelError> {
-        urdf::build(xml, source)
+        Self::from_urdf_str_with(xml, source, &UrdfOptions::default())
+    }
+
+    /// Loads and validates URDF text with the given options.
+    pub fn from_urdf_str_with(xml: &str, source: &str, options: &UrdfOptions) -> Result<RobotModel, ModelError> {
+        urdf::build(xml, source, options)
+    }
+
+    /// What loading repaired or accepted with reservations (inertias within the repair
+    /// tolerance, inconsistent but usable inertias), one message per link.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     /// Robot name from the URDF.
@@ -177,42 +234,60 @@ impl RobotModel {
         &self.source
     }
 
-    /// Number of velocity variables = number of moving joints (= nq for this model class).
+    /// Number of generalized coordinates (= velocity variables = nq for this model class): the
+    /// moving joints, less the mimic joints that follow their leader.
     pub fn nv(&self) -> usize {
+        self.joint_names.len()
+    }
+
+    /// Number of moving joints of the tree (≥ [`Self::nv`]).
+    pub fn njoints(&self) -> usize {
         self.bodies.len()
     }
 
-    /// Moving joint names in model order.
+    /// Names of the generalized coordinates in model order (each is its driving joint's name).
     pub fn joint_names(&self) -> &[String] {
         &self.joint_names
     }
 
-    /// Index of a moving joint by name.
+    /// Names of all moving joints of the tree, index = joint index.
+    pub fn moving_joint_names(&self) -> &[String] {
+        &self.moving_joint_names
+    }
+
+    /// Generalized coordinate of a joint name (None for unknown names and followed mimic joints).
     pub fn joint_index(&self, name: &str) -> Option<usize> {
         self.joint_names.iter().position(|n| n == name)
     }
 
-    /// Joint limits in model order.
+    /// Limits of the generalized coordinates in model order.
     pub fn joint_limits(&self) -> &[JointLimits] {
         &self.limits
     }
 
-    /// Kind of joint `j`.
+    /// Coordinate, multiplier and offset driving moving joint `j`: its value is
+    /// `multiplier · q[coordinate] + offset` (`(j, 1, 0)` without followed mimic joints).
+    pub fn joint_coordinate(&self, j: usize) -> (usize, f64, f64) {
+        let b = &self.bodies[j];
+        (b.coord, b.multiplier, b.offset)
+    }
+
+    /// Kind of moving joint `j` (`j < njoints()`).
     pub fn joint_kind(&self, j: usize) -> JointKind {
         self.bodies[j].kind
     }
 
-    /// Unit axis of joint `j` in its own frame.
+    /// Unit axis of moving joint `j` in its own frame.
     pub fn joint_axis(&self, j: usize) -> &Vector3<f64> {
         &self.bodies[j].axis
     }
 
-    /// Parent moving joint of joint `j` (None: attached to the world).
+    /// Parent moving joint of moving joint `j` (None: attached to the world).
     pub fn joint_parent(&self, j: usize) -> Option<usize> {
         self.bodies[j].parent
     }
 
-    /// Whether joint `ancestor` moves joint `j` (a joint supports itself).
+    /// Whether moving joint `ancestor` moves moving joint `j` (a joint supports itself).
     pub fn joint_supports(&self, ancestor: usize, j: usize) -> bool {
         let mut k = Some(j);
         while let Some(i) = k {
@@ -264,7 +339,7 @@ impl RobotModel {
         self.frame_names.iter().position(|n| n == link_name)
     }
 
-    /// The joint that moves frame `frame` (None: attached to the world).
+    /// The moving joint that moves frame `frame` (None: attached to the world).
     pub fn frame_parent_joint(&self, frame: usize) -> Option<usize> {
         self.frames[frame].body
     }
@@ -279,7 +354,7 @@ impl RobotModel {
         &self.frames[frame].collisions
     }
 
-    /// For every moving joint, the frame of the link it moves directly (its child link).
+    /// For moving joint `j`, the frame of the link it moves directly (its child link).
     pub fn joint_child_frame(&self, j: usize) -> usize {
         self.bodies[j].frame
     }
@@ -329,10 +404,10 @@ pub struct ModelData {
 impl ModelData {
     /// Allocates the workspace for `model`.
     pub fn new(model: &RobotModel) -> Self {
-        let n = model.nv();
+        let n = model.njoints();
         Self {
-            q: vec![0.0; n],
-            qd: vec![0.0; n],
+            q: vec![0.0; model.nv()],
+            qd: vec![0.0; model.nv()],
             body_pose: vec![Isometry3::identity(); n],
             body_rot: vec![Matrix3::identity(); n],
             body_pos: vec![Vector3::zeros(); n],

@@ -18,8 +18,7 @@ fn check_out(model: &RobotModel, out: &DVector<f64>) -> Result<(), ModelError> {
 fn rnea_impl(model: &RobotModel, data: &mut ModelData, qdd: Option<&[f64]>, tau: &mut DVector<f64>) {
     // Gravity enters as a fictitious upward acceleration of the base (RBDA Sec. 5.3).
     let a0 = svec(&Vector3::zeros(), &(-model.gravity));
-    let n = model.nv();
-    for i in 0..n {
+    for i in 0..model.njoints() {
         let b = &model.bodies[i];
         let ap = match b.parent {
             Some(p) => data.a[p],
@@ -27,7 +26,7 @@ fn rnea_impl(model: &RobotModel, data: &mut ModelData, qdd: Option<&[f64]>, tau:
         };
         let mut a = ap;
         if let Some(qdd) = qdd {
-            a += data.s[i] * qdd[i];
+            a += data.s[i] * qdd[b.coord];
         }
         let inertia = &data.inertia_w[i];
         a += data.c[i];
@@ -39,11 +38,13 @@ fn rnea_impl(model: &RobotModel, data: &mut ModelData, qdd: Option<&[f64]>, tau:
     backward_pass(model, data, tau);
 }
 
-/// RNEA's second pass: `τ_i = S_iᵀ f_i`, each body's force added to its parent's.
+/// RNEA's second pass: `τ_i = S_iᵀ f_i`, each body's force added to its parent's (a followed
+/// mimic joint's torque adds to its leader's coordinate).
 fn backward_pass(model: &RobotModel, data: &mut ModelData, tau: &mut DVector<f64>) {
-    for i in (0..model.nv()).rev() {
+    tau.fill(0.0);
+    for i in (0..model.njoints()).rev() {
         let f: SVec = data.f[i];
-        tau[i] = data.s[i].dot(&f);
+        tau[model.bodies[i].coord] += data.s[i].dot(&f);
         if let Some(p) = model.bodies[i].parent {
             data.f[p] += f;
         }

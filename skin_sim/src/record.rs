@@ -2,7 +2,10 @@
 //! arrangement switches, everything the metrics, the summary, the plots (`skin_sim::plot`) and the
 //! bag writer (`skin_sim::bag`) read. Plain data; nothing in it is computed twice.
 
+use skin_core::skin::markers::SkinMarker;
 use skin_core::supervisor::{Mode, SupervisorInput};
+
+use crate::view::View;
 
 /// One control cycle: the measurements the controller got, what it decided and what the
 /// simulation measured at the same instant.
@@ -68,20 +71,28 @@ pub struct Switch {
     pub to: Mode,
 }
 
-/// The simulation's state at one moment of a run, for rendering (`keyframes.json`).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+/// The simulation's state at one moment of a run, for the recording's `/tf` and `/skin/markers`
+/// and for rendering (`keyframes.json`): one frame of the run's [`View`].
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct KeyFrame {
     /// Simulation time \[s\].
     pub t_s: f64,
-    /// What happens then (`start`, `end`, a switch `(a) -> (b)`).
+    /// What happens then (`start`, `end`, a switch `(a) -> (b)`) for a key frame; empty for a
+    /// frame of the view rate.
     pub label: String,
+    /// The arrangement (`config/supervisor.yaml`'s name).
+    pub mode: String,
     /// MuJoCo `qpos` (robot joints, movable objects).
     pub qpos: Vec<f64>,
     /// MuJoCo `mocap_pos` (persons).
     pub mocap_pos: Vec<[f64; 3]>,
+    /// World (odom) pose of every link of [`View::links`], `[x, y, z, qx, qy, qz, qw]`.
+    pub poses: Vec<[f64; 7]>,
+    /// The `/skin/markers` updates since the previous frame (applied in order, as RViz does).
+    pub markers: Vec<SkinMarker>,
 }
 
-/// Most key frames one run keeps: the start, the first switches, the end.
+/// Most key frames (labelled frames) one run keeps: the start, the first switches, the end.
 pub const MAX_KEY_FRAMES: usize = 8;
 
 /// A whole run.
@@ -113,18 +124,15 @@ pub struct RunRecord {
     pub wall_time_s: f64,
     /// The MJCF the run simulated (primitive geoms only: self-contained).
     pub mjcf: String,
-    /// The state at the start, at the first switches and at the end (at most [`MAX_KEY_FRAMES`]).
-    pub key_frames: Vec<KeyFrame>,
+    /// What a viewer sees: frames at the view rate and the key frames (the start, the first
+    /// switches, the end; at most [`MAX_KEY_FRAMES`]).
+    pub view: View,
 }
 
 impl RunRecord {
-    /// Keeps `world`'s state as a key frame labelled `label` (the last one replaced when full,
-    /// so that the end is always kept).
-    pub fn key_frame(&mut self, world: &crate::world::World, label: String) {
-        if self.key_frames.len() == MAX_KEY_FRAMES {
-            self.key_frames.pop();
-        }
-        self.key_frames.push(world.key_frame(label));
+    /// The key frames: the labelled frames of the view.
+    pub fn key_frames(&self) -> impl Iterator<Item = &KeyFrame> {
+        self.view.frames.iter().filter(|f| !f.label.is_empty())
     }
 
     /// Simulated duration \[s\]: control cycles times the control period.

@@ -232,9 +232,9 @@ impl World {
         self.data.model()
     }
 
-    /// The current state as a key frame labelled `label`.
+    /// The current MuJoCo state as a key frame labelled `label` (no poses, no markers).
     pub fn key_frame(&self, label: String) -> KeyFrame {
-        KeyFrame { t_s: self.time(), label, qpos: self.data.qpos().to_vec(), mocap_pos: self.data.mocap_pos().to_vec() }
+        KeyFrame { t_s: self.time(), label, qpos: self.data.qpos().to_vec(), mocap_pos: self.data.mocap_pos().to_vec(), ..KeyFrame::default() }
     }
 
     /// The generated MJCF of the world.

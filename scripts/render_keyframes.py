@@ -329,6 +329,9 @@ def main() -> int:
         return 3
     annotate = Annotator(args.title or args.dir.resolve().name)
     stills = [] if args.no_stills else [k for k, f in enumerate(frames) if f["label"]]
+    if stills:  # an earlier run's key frames would mix with these
+        for old in args.dir.glob("keyframe_*.png"):
+            old.unlink()
     in_video = video_indices(frames, view["spec"]["fps"]) if (args.video or args.gif) else []
     video = set(in_video)
     gif_frames = set(in_video[::2])

@@ -40,7 +40,8 @@ def test_graph_run_writes_every_output_with_skin_sims_metrics(runs):
     for name in OUTPUTS:
         assert (graph_dir / name).stat().st_size > 0, name
     assert (graph_dir / "figure.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    labels = [[k["label"] for k in json.loads((d / "keyframes.json").read_text())] for d in (graph_dir, local_dir)]
+    labels = [[k["label"] for k in json.loads((d / "keyframes.json").read_text())["frames"] if k["label"]]
+              for d in (graph_dir, local_dir)]
     assert labels[0] == labels[1] and labels[0][0] == "start" and labels[0][-1] == "end", labels
     got = json.loads((graph_dir / "metrics.json").read_text())
     want = json.loads((local_dir / "metrics.json").read_text())
@@ -67,5 +68,7 @@ def test_graph_run_bag_reads_with_rosbags(runs):
     for topic in ("/clock", "/joint_states", "/arm/forward_velocity_controller/commands", "/controller/state"):
         assert counts.get(topic) == PERIODS, (topic, counts)
     assert counts.get("/supervisor/arrangement", 0) >= 1
+    # what a viewer needs (test_run_view.py checks their content on an in-process run)
+    assert counts.get("/robot_description") == 1 and counts.get("/tf", 0) >= 1 and counts.get("/skin/markers", 0) >= 1, counts
     metrics = json.loads((graph_dir / "metrics.json").read_text())
     assert last_state.goal_error == pytest.approx(metrics["goal_error_m"], abs=1e-12)

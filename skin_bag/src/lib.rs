@@ -18,7 +18,7 @@ use thiserror::Error;
 pub use defs::full_definition;
 pub use msgs::RosMessage;
 pub use reader::{read_bag, BagMessage};
-pub use writer::BagWriter;
+pub use writer::{BagWriter, TRANSIENT_LOCAL_QOS};
 
 /// Errors writing or reading a bag; each names the file (and the topic where there is one).
 #[derive(Debug, Error)]

@@ -30,6 +30,9 @@ ros_type! {
     PatchWrenchArray => "skin_msgs/msg/PatchWrenchArray",
     Arrangement => "skin_msgs/msg/Arrangement",
     ControllerState => "skin_msgs/msg/ControllerState",
+    StringMsg => "std_msgs/msg/String",
+    TfMessage => "tf2_msgs/msg/TFMessage",
+    MarkerArray => "visualization_msgs/msg/MarkerArray",
 }
 
 /// `builtin_interfaces/Time`.
@@ -364,6 +367,155 @@ pub struct ControllerState {
     pub issue_names: Vec<String>,
     /// ... and counts.
     pub issue_counts: Vec<u64>,
+}
+
+/// `std_msgs/String` (`/robot_description`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct StringMsg {
+    /// The text.
+    pub data: String,
+}
+
+/// `builtin_interfaces/Duration`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Duration {
+    /// Seconds.
+    pub sec: i32,
+    /// Nanoseconds within the second.
+    pub nanosec: u32,
+}
+
+/// `geometry_msgs/Transform`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Transform {
+    /// Translation \[m\].
+    pub translation: Vector3,
+    /// Rotation.
+    pub rotation: Quaternion,
+}
+
+/// `geometry_msgs/TransformStamped`: the pose of `child_frame_id` in `header.frame_id`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TransformStamped {
+    /// Stamp; `frame_id`: the parent frame.
+    pub header: Header,
+    /// The child frame.
+    pub child_frame_id: String,
+    /// Child frame in the parent frame.
+    pub transform: Transform,
+}
+
+/// `tf2_msgs/TFMessage` (`/tf`, `/tf_static`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TfMessage {
+    /// The transforms.
+    pub transforms: Vec<TransformStamped>,
+}
+
+/// `std_msgs/ColorRGBA`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct ColorRgba {
+    /// Red, \[0, 1\].
+    pub r: f32,
+    /// Green, \[0, 1\].
+    pub g: f32,
+    /// Blue, \[0, 1\].
+    pub b: f32,
+    /// Alpha, \[0, 1\].
+    pub a: f32,
+}
+
+/// `sensor_msgs/CompressedImage` (a marker's texture; empty in ours).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct CompressedImage {
+    /// Stamp and optical frame.
+    pub header: Header,
+    /// Format (`jpeg`, `png`, ...).
+    pub format: String,
+    /// Compressed image.
+    pub data: Vec<u8>,
+}
+
+/// `visualization_msgs/UVCoordinate`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct UvCoordinate {
+    /// u.
+    pub u: f32,
+    /// v.
+    pub v: f32,
+}
+
+/// `visualization_msgs/MeshFile`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct MeshFile {
+    /// File name.
+    pub filename: String,
+    /// File content.
+    pub data: Vec<u8>,
+}
+
+/// `visualization_msgs/Marker`, every field in `.msg` order.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Marker {
+    /// Stamp; `frame_id`: the frame of `pose` and `points`.
+    pub header: Header,
+    /// Namespace.
+    pub ns: String,
+    /// Id within the namespace.
+    pub id: i32,
+    /// Shape (`ARROW` 0, ..., `SPHERE_LIST` 7, ...).
+    #[serde(rename = "type")]
+    pub type_: i32,
+    /// `ADD` 0, `DELETE` 2, `DELETEALL` 3.
+    pub action: i32,
+    /// Pose of the marker in the frame.
+    pub pose: Pose,
+    /// Size \[m\].
+    pub scale: Vector3,
+    /// Colour of the whole marker.
+    pub color: ColorRgba,
+    /// How long it is shown (0: until replaced).
+    pub lifetime: Duration,
+    /// Whether it moves with its frame after it was received.
+    pub frame_locked: bool,
+    /// Points (lists, arrows with two points).
+    pub points: Vec<Point>,
+    /// Per-point colours.
+    pub colors: Vec<ColorRgba>,
+    /// Texture resource name.
+    pub texture_resource: String,
+    /// Texture image.
+    pub texture: CompressedImage,
+    /// Texture coordinates.
+    pub uv_coordinates: Vec<UvCoordinate>,
+    /// Text of a text marker.
+    pub text: String,
+    /// Mesh resource name.
+    pub mesh_resource: String,
+    /// Embedded mesh.
+    pub mesh_file: MeshFile,
+    /// Whether the mesh's own materials are used.
+    pub mesh_use_embedded_materials: bool,
+}
+
+impl Marker {
+    /// `type`: an arrow.
+    pub const ARROW: i32 = 0;
+    /// `type`: a list of spheres.
+    pub const SPHERE_LIST: i32 = 7;
+    /// `action`: add or replace.
+    pub const ADD: i32 = 0;
+    /// `action`: remove.
+    pub const DELETE: i32 = 2;
+    /// `action`: remove every marker.
+    pub const DELETEALL: i32 = 3;
+}
+
+/// `visualization_msgs/MarkerArray`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct MarkerArray {
+    /// The markers, applied in order.
+    pub markers: Vec<Marker>,
 }
 
 /// Serde for fixed arrays longer than serde's built-in 32 (the 6x6 covariances): a tuple, which

@@ -134,3 +134,65 @@ fn a_missing_file_is_named() {
     let err = read_bag("/nonexistent/dir/x.mcap").unwrap_err().to_string();
     assert!(err.starts_with("/nonexistent/dir/x.mcap:"), "{err}");
 }
+
+#[test]
+fn tf_markers_and_a_latched_description_round_trip() {
+    let dir = std::env::temp_dir().join(format!("skin_sim_bag_viz_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("viz.mcap");
+    let tf = TfMessage {
+        transforms: vec![TransformStamped {
+            header: header(7, "odom"),
+            child_frame_id: "base".into(),
+            transform: Transform {
+                translation: Vector3 { x: 1.0, y: -2.0, z: 0.5 },
+                rotation: Quaternion { x: 0.0, y: 0.0, z: 0.6, w: 0.8 },
+            },
+        }],
+    };
+    let cells = Marker {
+        header: header(7, "link3"),
+        ns: "skin_cells".into(),
+        id: 2,
+        type_: Marker::SPHERE_LIST,
+        points: vec![Point { x: 0.1, y: 0.0, z: 0.0 }],
+        colors: vec![ColorRgba { r: 1.0, g: 0.5, b: 0.5, a: 1.0 }],
+        ..Default::default()
+    };
+    let markers = MarkerArray {
+        markers: vec![Marker { action: Marker::DELETEALL, ..Default::default() }, cells],
+    };
+    let description = StringMsg { data: "<robot name=\"r\"/>".into() };
+    let mut bag = BagWriter::create(&path).unwrap();
+    let definition = full_definition(StringMsg::TYPE_NAME).unwrap();
+    bag.add_topic("/robot_description", StringMsg::TYPE_NAME, &definition, TRANSIENT_LOCAL_QOS).unwrap();
+    bag.write("/robot_description", 0, &description).unwrap();
+    bag.write("/tf", 7, &tf).unwrap();
+    bag.write("/skin/markers", 7, &markers).unwrap();
+    bag.finish().unwrap();
+
+    let msgs = read_bag(&path).unwrap();
+    assert_eq!(msgs[0].decode::<StringMsg>().unwrap(), description);
+    assert_eq!(msgs[1].decode::<TfMessage>().unwrap(), tf);
+    assert_eq!(msgs[2].decode::<MarkerArray>().unwrap(), markers);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn marker_definition_carries_every_nested_type() {
+    let full = full_definition(MarkerArray::TYPE_NAME).unwrap();
+    for dep in [
+        "visualization_msgs/Marker",
+        "visualization_msgs/UVCoordinate",
+        "visualization_msgs/MeshFile",
+        "sensor_msgs/CompressedImage",
+        "std_msgs/ColorRGBA",
+        "builtin_interfaces/Duration",
+        "geometry_msgs/Pose",
+    ] {
+        assert!(full.contains(&format!("MSG: {dep}\n")), "{dep} missing");
+    }
+    let tf = full_definition(TfMessage::TYPE_NAME).unwrap();
+    assert!(tf.starts_with("geometry_msgs/TransformStamped[] transforms\n"));
+    assert!(tf.contains("MSG: geometry_msgs/Transform\n"));
+}

@@ -7,6 +7,14 @@ use std::path::{Path, PathBuf};
 
 use super::{cdr, defs, BagError, RosMessage};
 
+/// The offered QoS of a latched publisher (reliable, transient local, depth 1) in rosbag2's YAML,
+/// for [`BagWriter::add_topic`]: a player re-offers it, so late subscribers (RViz's robot model
+/// on `/robot_description`) still get the message.
+pub const TRANSIENT_LOCAL_QOS: &str = "- history: keep_last\n  depth: 1\n  reliability: reliable\n  durability: transient_local\n  \
+deadline:\n    sec: 9223372036\n    nsec: 854775807\n  lifespan:\n    sec: 9223372036\n    nsec: 854775807\n  \
+liveliness: automatic\n  liveliness_lease_duration:\n    sec: 9223372036\n    nsec: 854775807\n  \
+avoid_ros_namespace_conventions: false\n";
+
 /// A channel registered for a topic.
 struct Channel {
     id: u16,

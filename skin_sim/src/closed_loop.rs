@@ -21,6 +21,7 @@ use crate::probe::ContactProbe;
 use crate::record::{mode_name, CycleRecord, RunRecord, Switch};
 use crate::schedule::{Schedule, ScheduleError, ScheduledInputs};
 use crate::scene::Scene;
+use crate::view::ViewRecorder;
 use crate::world::{World, WorldError};
 
 /// Why a closed loop could not be built or run.
@@ -62,6 +63,7 @@ pub struct ClosedLoop {
     steps_per_cycle: u64,
     dt_s: f64,
     scan: Vec<Vector2<f64>>,
+    view: ViewRecorder,
     record: RunRecord,
 }
 
@@ -117,7 +119,7 @@ impl ClosedLoop {
             switches: Vec::new(),
             wall_time_s: 0.0,
             mjcf: world.mjcf().to_string(),
-            key_frames: Vec::new(),
+            view: Default::default(),
         };
         Ok(ClosedLoop {
             steps_per_cycle: (1.0 / (spec.control_rate_hz * spec.timestep_s)).round() as u64,
@@ -125,6 +127,7 @@ impl ClosedLoop {
             interactions: Interactions::new(scene, controller.config().tasks.base_avoidance),
             probe: ContactProbe::new(&world, ee),
             scan: Vec::new(),
+            view: ViewRecorder::new(scene, controller.config()),
             schedule,
             controller,
             world,
@@ -199,17 +202,16 @@ impl ClosedLoop {
             fault,
             compute_us,
         };
-        if self.record.cycles.is_empty() {
-            self.record.key_frame(&self.world, "start".into());
-        }
+        let mut event = self.record.cycles.is_empty().then(|| "start".to_string());
         if let Some(tr) = self.controller.supervisor().last_transition() {
             self.record.switches.push(Switch {
                 t_s: tr.t_s,
                 from: tr.from,
                 to: tr.to,
             });
-            self.record.key_frame(&self.world, format!("{} -> {}", mode_name(tr.from), mode_name(tr.to)));
+            event = Some(format!("{} -> {}", mode_name(tr.from), mode_name(tr.to)));
         }
+        self.view.cycle(&self.world, cycle.mode, event);
         let commands = &self.controller.output().commands;
         self.world
             .set_arm_velocity_commands(&commands.joint_velocities)
@@ -233,7 +235,8 @@ impl ClosedLoop {
             progress((k + 1) as f64 / cycles as f64);
         }
         self.record.wall_time_s = start.elapsed().as_secs_f64();
-        self.record.key_frame(&self.world, "end".into());
+        let mode = self.record.cycles.last().map_or(self.controller.output().mode, |c| c.mode);
+        self.record.view = self.view.finish(&self.world, mode);
         self.record
     }
 }

@@ -12,7 +12,8 @@
 //! - [`scenario`], [`runner`], [`metrics`], [`outcome`], [`report`]: the named scenarios of the
 //!   papers, a run from scene to report, `metrics.json`, the outcome checks, the summary;
 //! - [`plot`]: figures in the papers' style; [`outputs`] (with the `skin_bag` crate's MCAP writer)
-//!   turns a run into `figure.png` and `run.mcap`;
+//!   turns a run into `figure.png`, `run.mcap` and the rendered frames of its [`view`] (what
+//!   RViz would show: robot, skin markers, contact arrows);
 //! - [`study`]: the speed/accuracy study over control rate, timestep, skin density and the
 //!   inverse's damping (`skin_sim sweep`, `docs/tradeoffs.md`).
 #![warn(missing_docs)]
@@ -39,6 +40,7 @@ pub mod scene;
 pub mod schedule;
 pub mod skin_sensor;
 pub mod study;
+pub mod view;
 pub mod world;
 
 pub use scene::{Scene, SceneError};

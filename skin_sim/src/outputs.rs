@@ -7,39 +7,53 @@ use anyhow::Context;
 use skin_core::resolver::BASE_JOINTS;
 use skin_core::supervisor::Mode;
 
+use nalgebra::{Isometry3, Quaternion as NaQuaternion, Translation3, UnitQuaternion};
+use skin_core::skin::markers::{MarkerAction, MarkerShape, Rgba, SkinMarker};
+
 use skin_bag::msgs::{
-    Arrangement, Clock, ControllerState, Float64MultiArray, Header, JointState, Time, Twist, Vector3,
+    Arrangement, Clock, ColorRgba, ControllerState, Float64MultiArray, Header, JointState, Marker, MarkerArray, Point, Quaternion, StringMsg, TfMessage,
+    Time, Transform, TransformStamped, Twist, Vector3,
 };
-use skin_bag::BagWriter;
+use skin_bag::{full_definition, BagWriter, RosMessage, TRANSIENT_LOCAL_QOS};
 use crate::plot::{guidance_figure, intervals_where, paper000_figure, paper003_figure, GuidanceSignals, Paper000Signals, Paper003Signals};
 use crate::record::{CycleRecord, RunRecord};
+use crate::world::KeyFrame;
+use crate::view::{View, ODOM_FRAME};
 use crate::report::{MetricsJson, RunOutput, RunReport, SummaryText};
 
 /// Every product of a run, as `skin_sim run` writes them: `metrics.json`, `summary.txt`,
-/// `figure.png`, `run.mcap`.
-pub const ALL: [&dyn RunOutput; 5] = [&MetricsJson, &SummaryText, &FigurePng, &RunBag, &KeyFrames];
+/// `figure.png`, `run.mcap`, the rendered key frames.
+pub const ALL: [&dyn RunOutput; 5] = [&MetricsJson, &SummaryText, &FigurePng, &RunBag, &KeyFrames { video: false }];
 
-/// Rendered key frames: `scene.xml` (the MJCF of the run) and `keyframes.json` (MuJoCo's state at
-/// the start, at the first switches and at the end), rendered to `keyframe_<k>_<t>s.png` by
-/// `scripts/render_keyframes.py` (MuJoCo's renderer through EGL). Where that is not possible (no
-/// EGL, no Python with mujoco, no script beside the binary's sources) `keyframes.txt` says why,
-/// and the run goes on.
-pub struct KeyFrames;
+/// Rendered frames: `scene.xml` (the MJCF of the run) and `keyframes.json` (the run's
+/// [`View`]: per frame MuJoCo's state, the link poses and the `/skin/markers` updates), rendered
+/// by `scripts/render_keyframes.py` (MuJoCo's renderer through EGL) to `keyframe_<k>_<t>s.png`
+/// per key frame (the start, the first switches, the end) and, with `video`, to `run.mp4` (or
+/// `run.gif` without ffmpeg), with the skin, the contact arrows, the goal and an overlay. Where
+/// that is not possible (no EGL, no Python with mujoco, no script beside the binary's sources)
+/// `keyframes.txt` says why, and the run goes on.
+pub struct KeyFrames {
+    /// Also render the video (the script prints its progress on stderr).
+    pub video: bool,
+}
 
 impl RunOutput for KeyFrames {
     fn write(&self, report: &RunReport, dir: &Path) -> anyhow::Result<PathBuf> {
         let r = &report.record;
         std::fs::write(dir.join("scene.xml"), &r.mjcf).context("writing scene.xml")?;
-        let frames = serde_json::to_string(&r.key_frames).context("key frames as JSON")?;
+        let frames = serde_json::to_string(&r.view).context("the view as JSON")?;
         let json = dir.join("keyframes.json");
         std::fs::write(&json, frames).with_context(|| format!("writing {}", json.display()))?;
         let script = crate::scenario::config_dir().join("../scripts/render_keyframes.py");
-        let rendered = std::process::Command::new("python3")
-            .arg(&script)
-            .arg(dir)
+        let mut command = std::process::Command::new("python3");
+        command.arg(&script).arg(dir).arg("--title").arg(&r.name);
+        if self.video {
+            command.arg("--video").stderr(std::process::Stdio::inherit());
+        }
+        let rendered = command
             .output()
             .map_err(|e| format!("python3 {}: {e}", script.display()))
-            .and_then(|o| if o.status.success() { Ok(()) } else { Err(String::from_utf8_lossy(&o.stderr).trim().to_string()) });
+            .and_then(|o| if o.status.success() { Ok(()) } else { Err(format!("{}: {}", o.status, String::from_utf8_lossy(&o.stderr).trim())) });
         match rendered {
             Ok(()) => Ok(json),
             Err(why) => {
@@ -134,10 +148,72 @@ impl RunOutput for FigurePng {
 
 /// `run.mcap`: per control cycle `/clock`, `/joint_states`, the arm command topics (one per arm:
 /// `/<side>_arm/forward_velocity_controller/commands` for TOMM's `left_`/`right_` joints,
-/// `/arm/...` otherwise), `/base/cmd_vel` (a model with a base), `/controller/state`; and
-/// `/supervisor/arrangement` at the start and at every switch. The skin cells, odometry and scan
-/// are not in the run record, so not in the bag.
+/// `/arm/...` otherwise), `/base/cmd_vel` (a model with a base), `/controller/state`;
+/// `/supervisor/arrangement` at the start and at every switch; `/robot_description` once
+/// (transient local, as `robot_state_publisher` offers it); per frame of the run's view `/tf`
+/// (`odom -> base_link` and every link from the joint states, [`crate::view::tf_tree`]) and
+/// `/skin/markers` (the aggregator's marker updates). So Foxglove or RViz replaying the file shows
+/// the robot, the skin and the contacts. The skin cells, odometry and scan are not in the run
+/// record, so not in the bag.
 pub struct RunBag;
+
+fn isometry(p: &[f64; 7]) -> Isometry3<f64> {
+    let q = UnitQuaternion::from_quaternion(NaQuaternion::new(p[6], p[3], p[4], p[5]));
+    Isometry3::from_parts(Translation3::new(p[0], p[1], p[2]), q)
+}
+
+/// `/tf` of one view frame: every link in its parent's frame.
+fn tf_message(view: &View, frame: &KeyFrame, stamp: Time) -> TfMessage {
+    let transforms = view
+        .links
+        .iter()
+        .zip(&view.parents)
+        .zip(&frame.poses)
+        .map(|((link, parent), pose)| {
+            let (parent_frame, relative) = match parent {
+                Some(p) => (view.links[*p].as_str(), isometry(&frame.poses[*p]).inv_mul(&isometry(pose))),
+                None => (ODOM_FRAME, isometry(pose)),
+            };
+            let (t, r) = (relative.translation.vector, relative.rotation.coords);
+            TransformStamped {
+                header: Header { stamp, frame_id: parent_frame.to_string() },
+                child_frame_id: link.clone(),
+                transform: Transform {
+                    translation: Vector3 { x: t.x, y: t.y, z: t.z },
+                    rotation: Quaternion { x: r.x, y: r.y, z: r.z, w: r.w },
+                },
+            }
+        })
+        .collect();
+    TfMessage { transforms }
+}
+
+fn color([r, g, b, a]: Rgba) -> ColorRgba {
+    ColorRgba { r, g, b, a }
+}
+
+/// The `visualization_msgs/Marker` of one skin marker update, as the aggregator publishes it.
+fn marker_msg(m: &SkinMarker, stamp: Time) -> Marker {
+    let action = match m.action {
+        MarkerAction::DeleteAll => return Marker { action: Marker::DELETEALL, ..Default::default() },
+        MarkerAction::Delete => Marker::DELETE,
+        MarkerAction::Add => Marker::ADD,
+    };
+    let mut out = Marker { header: Header { stamp, frame_id: String::new() }, ns: m.ns.to_string(), id: m.id, action, ..Default::default() };
+    if m.action == MarkerAction::Add {
+        out.type_ = match m.shape {
+            MarkerShape::SphereList => Marker::SPHERE_LIST,
+            MarkerShape::Arrow => Marker::ARROW,
+        };
+        out.header.frame_id.clone_from(&m.frame);
+        let [x, y, z] = m.scale;
+        out.scale = Vector3 { x, y, z };
+        out.color = color(m.color);
+        out.points = m.points.iter().map(|&[x, y, z]| Point { x, y, z }).collect();
+        out.colors = m.colors.iter().map(|&c| color(c)).collect();
+    }
+    out
+}
 
 /// The command topic of an arm joint, by its name's side prefix.
 fn arm_topic(joint: &str) -> &'static str {
@@ -158,6 +234,15 @@ fn arrangement_msg(mode: Mode, t_s: f64) -> Arrangement {
     Arrangement { mode: mode.as_u8(), switch_time: Time::from_nanos(nanos(t_s)), ..Default::default() }
 }
 
+fn write_view_frame(bag: &mut BagWriter, view: &View, f: &KeyFrame) -> anyhow::Result<()> {
+    let (ns, stamp) = (nanos(f.t_s), Time::from_nanos(nanos(f.t_s)));
+    bag.write("/tf", ns, &tf_message(view, f, stamp))?;
+    if !f.markers.is_empty() {
+        bag.write("/skin/markers", ns, &MarkerArray { markers: f.markers.iter().map(|m| marker_msg(m, stamp)).collect() })?;
+    }
+    Ok(())
+}
+
 impl RunOutput for RunBag {
     fn write(&self, report: &RunReport, dir: &Path) -> anyhow::Result<PathBuf> {
         let path = dir.join("run.mcap");
@@ -170,6 +255,10 @@ impl RunOutput for RunBag {
         if let Some(first) = r.cycles.first() {
             bag.write("/supervisor/arrangement", nanos(first.t_s), &arrangement_msg(first.mode, first.t_s))?;
         }
+        let view = &r.view;
+        bag.add_topic("/robot_description", StringMsg::TYPE_NAME, &full_definition(StringMsg::TYPE_NAME).map_err(anyhow::Error::msg)?, TRANSIENT_LOCAL_QOS)?;
+        bag.write("/robot_description", 0, &StringMsg { data: view.robot_description.clone() })?;
+        let mut frames = view.frames.iter().peekable();
         let mut switches = r.switches.iter().peekable();
         let mut safe_stops = 0;
         for c in &r.cycles {
@@ -213,6 +302,13 @@ impl RunOutput for RunBag {
             while let Some(sw) = switches.next_if(|sw| sw.t_s <= c.t_s) {
                 bag.write("/supervisor/arrangement", ns, &arrangement_msg(sw.to, sw.t_s))?;
             }
+            while let Some(f) = frames.next_if(|f| f.t_s <= c.t_s) {
+                write_view_frame(&mut bag, view, f)?;
+            }
+        }
+        // the end frame, after the last cycle
+        for f in frames {
+            write_view_frame(&mut bag, view, f)?;
         }
         bag.finish().with_context(|| format!("finishing {}", path.display()))?;
         Ok(path)

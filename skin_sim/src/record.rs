@@ -3,7 +3,9 @@
 //! bag writer (the `skin_bag` crate) read. Plain data; nothing in it is computed twice.
 
 use skin_core::supervisor::{Mode, SupervisorInput};
-use crate::world::{KeyFrame, World};
+use crate::world::KeyFrame;
+
+use crate::view::View;
 
 /// One control cycle: the measurements the controller got, what it decided and what the
 /// simulation measured at the same instant.
@@ -69,7 +71,7 @@ pub struct Switch {
     pub to: Mode,
 }
 
-/// Most key frames one run keeps: the start, the first switches, the end.
+/// Most key frames (labelled frames) one run keeps: the start, the first switches, the end.
 pub const MAX_KEY_FRAMES: usize = 8;
 
 /// A whole run.
@@ -101,18 +103,15 @@ pub struct RunRecord {
     pub wall_time_s: f64,
     /// The MJCF the run simulated (primitive geoms only: self-contained).
     pub mjcf: String,
-    /// The state at the start, at the first switches and at the end (at most [`MAX_KEY_FRAMES`]).
-    pub key_frames: Vec<KeyFrame>,
+    /// What a viewer sees: frames at the view rate and the key frames (the start, the first
+    /// switches, the end; at most [`MAX_KEY_FRAMES`]).
+    pub view: View,
 }
 
 impl RunRecord {
-    /// Keeps `world`'s state as a key frame labelled `label` (the last one replaced when full,
-    /// so that the end is always kept).
-    pub fn key_frame(&mut self, world: &World, label: String) {
-        if self.key_frames.len() == MAX_KEY_FRAMES {
-            self.key_frames.pop();
-        }
-        self.key_frames.push(world.key_frame(label));
+    /// The key frames: the labelled frames of the view.
+    pub fn key_frames(&self) -> impl Iterator<Item = &KeyFrame> {
+        self.view.frames.iter().filter(|f| !f.label.is_empty())
     }
 
     /// Simulated duration \[s\]: control cycles times the control period.

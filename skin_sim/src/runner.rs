@@ -18,6 +18,7 @@ use crate::record::{mode_name, CycleRecord, RunRecord, Switch};
 use crate::report::RunReport;
 use crate::scenario::{self, ForceTargets, Scenario};
 use crate::scene::{RunOverrides, Scene};
+use crate::view::ViewRecorder;
 
 /// What to run: a scene, the controller setup for it, the targets it is judged on.
 #[derive(Debug, Clone, PartialEq)]
@@ -145,6 +146,7 @@ pub struct ExternalRun {
     probe: ContactProbe,
     interactions: Interactions,
     hand: Option<HandForceMap>,
+    view: ViewRecorder,
     record: RunRecord,
     started: Instant,
 }
@@ -162,6 +164,7 @@ impl ExternalRun {
             probe: ContactProbe::new(world, ee),
             interactions: Interactions::new(&scene, config.tasks.base_avoidance),
             hand: HandForceMap::new(config),
+            view: ViewRecorder::new(&scene, config),
             record: in_process.record().clone(),
             target: target.clone(),
             scene,
@@ -174,14 +177,12 @@ impl ExternalRun {
     /// its answer.
     pub fn cycle(&mut self, world: &crate::world::World, force_n: Option<f64>, decision: Decision) {
         let t_s = world.time();
-        if self.record.cycles.is_empty() {
-            self.record.key_frame(world, "start".into());
-        }
+        let mut event = self.record.cycles.is_empty().then(|| "start".to_string());
         if let Some(last) = self.record.cycles.last().filter(|c| c.mode != decision.mode) {
             self.record.switches.push(Switch { t_s, from: last.mode, to: decision.mode });
-            let label = format!("{} -> {}", mode_name(last.mode), mode_name(decision.mode));
-            self.record.key_frame(world, label);
+            event = Some(format!("{} -> {}", mode_name(last.mode), mode_name(decision.mode)));
         }
+        self.view.cycle(world, decision.mode, event);
         let forces = self.probe.measure(world);
         // As the schedule gives it: a reference only with a hand to map it to.
         let (force_reference_n, force_reference_signal) = match (force_n, &self.hand) {
@@ -221,7 +222,8 @@ impl ExternalRun {
     /// [`ExternalRun::new`].
     pub fn finish(mut self, world: &crate::world::World) -> RunReport {
         self.record.wall_time_s = self.started.elapsed().as_secs_f64();
-        self.record.key_frame(world, "end".into());
+        let mode = self.record.cycles.last().map_or(Mode::Avoidance, |c| c.mode);
+        self.record.view = self.view.finish(world, mode);
         self.target.report(self.record, &self.scene, self.limits)
     }
 }

@@ -8,6 +8,7 @@ use std::sync::Once;
 use mujoco_rs::prelude::*;
 use nalgebra::{Isometry3, Point3, Vector3};
 use skin_core::resolver::BASE_JOINTS;
+use skin_core::skin::markers::SkinMarker;
 use skin_core::skin::signals::CellReading;
 use thiserror::Error;
 
@@ -18,17 +19,25 @@ use crate::scene::spec::push_scale;
 use crate::scene::{Scene, SceneError};
 use crate::skin_sensor::{SkinSensor, Touch};
 
-/// The simulation's state at one moment of a run, for rendering (`keyframes.json`).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+/// The simulation's state at one moment of a run, for the recording's `/tf` and `/skin/markers`
+/// and for rendering (`keyframes.json`): one frame of the run's [`crate::view::View`].
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct KeyFrame {
     /// Simulation time \[s\].
     pub t_s: f64,
-    /// What happens then (`start`, `end`, a switch `(a) -> (b)`).
+    /// What happens then (`start`, `end`, a switch `(a) -> (b)`) for a key frame; empty for a
+    /// frame of the view rate.
     pub label: String,
+    /// The arrangement (`config/supervisor.yaml`'s name).
+    pub mode: String,
     /// MuJoCo `qpos` (robot joints, movable objects).
     pub qpos: Vec<f64>,
     /// MuJoCo `mocap_pos` (persons).
     pub mocap_pos: Vec<[f64; 3]>,
+    /// World (odom) pose of every link of [`crate::view::View::links`], `[x, y, z, qx, qy, qz, qw]`.
+    pub poses: Vec<[f64; 7]>,
+    /// The `/skin/markers` updates since the previous frame (applied in order, as RViz does).
+    pub markers: Vec<SkinMarker>,
 }
 
 /// Errors building or driving a [`World`].
@@ -244,9 +253,9 @@ impl World {
         self.data.model()
     }
 
-    /// The current state as a key frame labelled `label`.
+    /// The current MuJoCo state as a key frame labelled `label` (no poses, no markers).
     pub fn key_frame(&self, label: String) -> KeyFrame {
-        KeyFrame { t_s: self.time(), label, qpos: self.data.qpos().to_vec(), mocap_pos: self.data.mocap_pos().to_vec() }
+        KeyFrame { t_s: self.time(), label, qpos: self.data.qpos().to_vec(), mocap_pos: self.data.mocap_pos().to_vec(), ..KeyFrame::default() }
     }
 
     /// The generated MJCF of the world.

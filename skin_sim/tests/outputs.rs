@@ -1,7 +1,7 @@
 //! A run's figure and bag: `figure.png` is a picture of the run, `run.mcap` carries its topics
 //! (every cycle's joint states and commands, the arrangement switches) and reads back.
 
-use skin_bag::msgs::{Arrangement, Float64MultiArray, JointState};
+use skin_bag::msgs::{Arrangement, Float64MultiArray, JointState, MarkerArray, StringMsg, TfMessage};
 use skin_bag::read_bag;
 use skin_sim::outputs::{FigurePng, KeyFrames, RunBag};
 use skin_sim::report::{write_all, RunOutput};
@@ -37,6 +37,17 @@ fn figure_and_bag_of_a_run() {
         assert_eq!(commands, r.cycles.len() * r.arm_joints.len(), "{name}: every arm joint every cycle");
         let first = messages.iter().find(|m| m.topic == "/supervisor/arrangement").unwrap().decode::<Arrangement>().unwrap();
         assert_eq!(first.mode, r.cycles[0].mode.as_u8());
+        // the view: the robot's description once, per view frame /tf, the markers when they change
+        let description = messages.iter().find(|m| m.topic == "/robot_description").unwrap().decode::<StringMsg>().unwrap();
+        assert!(description.data.contains("<robot"), "{name}");
+        assert_eq!(count("/robot_description"), 1);
+        assert_eq!(count("/tf"), r.view.frames.len(), "{name}");
+        let tf = messages.iter().find(|m| m.topic == "/tf").unwrap().decode::<TfMessage>().unwrap();
+        assert_eq!(tf.transforms.len(), r.view.links.len());
+        let changed = r.view.frames.iter().filter(|f| !f.markers.is_empty()).count();
+        assert_eq!(count("/skin/markers"), changed, "{name}");
+        let markers = messages.iter().find(|m| m.topic == "/skin/markers").unwrap().decode::<MarkerArray>().unwrap();
+        assert_eq!(markers.markers[0].action, 3, "{name}: the first update clears the display");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
@@ -48,13 +59,16 @@ fn key_frames_are_rendered_or_the_reason_is_written() {
     // the note says why and the states are still there.
     let target = RunTarget::from(scenario::find("intentional_contact").unwrap());
     let report = target.run(&RunOverrides { duration_s: Some(10.0), ..RunOverrides::default() }, |_| {}).unwrap();
-    let labels: Vec<&str> = report.record.key_frames.iter().map(|k| k.label.as_str()).collect();
+    let labels: Vec<&str> = report.record.key_frames().map(|k| k.label.as_str()).collect();
     assert_eq!(labels, ["start", "avoidance -> intentional_contact", "end"]);
     let dir = std::env::temp_dir().join(format!("skin_sim_keyframes_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let file = KeyFrames.write(&report, &dir).unwrap();
-    let states: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("keyframes.json")).unwrap()).unwrap();
-    assert_eq!(states.as_array().unwrap().len(), 3);
+    let file = KeyFrames { video: false }.write(&report, &dir).unwrap();
+    let view: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("keyframes.json")).unwrap()).unwrap();
+    let frames = view["frames"].as_array().unwrap();
+    // 10 fps over 10 s and the switch
+    assert_eq!(frames.len(), 102, "frames at the view rate, the switch, the end");
+    assert_eq!(frames.iter().filter(|f| f["label"] != "").count(), 3);
     assert!(std::fs::read_to_string(dir.join("scene.xml")).unwrap().contains("<mujoco"));
     let pngs: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().starts_with("keyframe_")).collect();
     if file == dir.join("keyframes.json") {

@@ -145,6 +145,14 @@ fn scene_errors_name_the_file_and_the_key() {
     assert!(e.contains("`base_motions[1].start_s`"), "{e}");
     let e = invalid("robot: {urdf: ../../urdf/nope.urdf}\nduration_s: 1\n");
     assert!(e.contains("`robot.urdf`"), "{e}");
+    let e = invalid(&planar7("view: {fps: 0}\n"));
+    assert!(e.contains("`view.fps`"), "{e}");
+    let e = invalid(&planar7("view: {fps: 1000}\n"));
+    assert!(e.contains("`view.fps`") && e.contains("control_rate_hz"), "{e}");
+    let e = invalid(&planar7("view: {elevation_deg: -95}\n"));
+    assert!(e.contains("`view.elevation_deg`"), "{e}");
+    let e = invalid(&planar7("view: {distance_m: -1}\n"));
+    assert!(e.contains("`view.distance_m`"), "{e}");
     assert!(matches!(
         Scene::from_yaml_str("robot: {urdf: x}\n", "bad.yaml", &scenes_dir()),
         Err(SceneError::Yaml(_))

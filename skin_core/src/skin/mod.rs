@@ -11,7 +11,8 @@
 //!
 //! Setup: [`layout::SkinLayout::load`] + `resolve` against the robot model,
 //! [`params::SkinParams::load`] for the characteristics ([`characteristic`]) and gains.
-//! [`tiling`] holds the geometry of the `skin_layout` generator.
+//! [`tiling`] holds the geometry of the `skin_layout` generator; [`markers`] what a viewer
+//! shows of the skin (`/skin/markers`).
 
 pub mod aggregate;
 pub mod cell_input;
@@ -20,6 +21,7 @@ pub mod characteristic;
 pub mod generate;
 pub mod layout;
 pub mod live;
+pub mod markers;
 pub mod params;
 pub mod repulsion;
 pub mod resolved;

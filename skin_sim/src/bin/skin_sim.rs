@@ -55,6 +55,10 @@ enum Command {
         /// No progress line on stderr.
         #[arg(long)]
         quiet: bool,
+        /// Also render a video of the run (run.mp4 through ffmpeg, else run.gif) with the skin
+        /// and contact overlay, at the scene's view.fps.
+        #[arg(long)]
+        video: bool,
     },
     /// Run the speed/accuracy study over control rate, timestep, skin density and the inverse's
     /// damping; write results.json and generate the document with its figures.
@@ -90,9 +94,9 @@ struct SweepArgs {
     quiet: bool,
 }
 
-/// The products of a run (`skin_sim::outputs::ALL`).
-fn outputs() -> Vec<Box<dyn RunOutput>> {
-    vec![Box::new(MetricsJson), Box::new(SummaryText), Box::new(FigurePng), Box::new(RunBag), Box::new(KeyFrames)]
+/// The products of a run (`skin_sim::outputs::ALL`), the video when asked for.
+fn outputs(video: bool) -> Vec<Box<dyn RunOutput>> {
+    vec![Box::new(MetricsJson), Box::new(SummaryText), Box::new(FigurePng), Box::new(RunBag), Box::new(KeyFrames { video })]
 }
 
 /// A progress line on stderr, redrawn at most every 2 % of the run on a terminal (every 25 %
@@ -174,7 +178,7 @@ fn sweep(args: SweepArgs) -> anyhow::Result<bool> {
 }
 
 fn run(args: Command) -> anyhow::Result<bool> {
-    let (target, out, controller, duration, control_rate, dt, seed, quiet) = match args {
+    let (target, out, controller, duration, control_rate, dt, seed, quiet, video) = match args {
         Command::List => {
             for s in &SCENARIOS {
                 println!("{:28} {}", s.name, s.description);
@@ -182,8 +186,8 @@ fn run(args: Command) -> anyhow::Result<bool> {
             return Ok(true);
         }
         Command::Sweep(args) => return sweep(args),
-        Command::Run { target, out, controller, duration, control_rate, dt, seed, quiet } => {
-            (target, out, controller, duration, control_rate, dt, seed, quiet)
+        Command::Run { target, out, controller, duration, control_rate, dt, seed, quiet, video } => {
+            (target, out, controller, duration, control_rate, dt, seed, quiet, video)
         }
     };
     let target = RunTarget::resolve(&target, controller).map_err(anyhow::Error::msg)?;
@@ -200,7 +204,7 @@ fn run(args: Command) -> anyhow::Result<bool> {
         }
     })?;
     let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&target.name));
-    let outputs = outputs();
+    let outputs = outputs(video);
     let outputs: Vec<&dyn RunOutput> = outputs.iter().map(|o| o.as_ref()).collect();
     let files = write_all(&report, &dir, &outputs)?;
     print!("{}", report.summary());

@@ -1,6 +1,6 @@
 //! Value checks of a scene file that need no robot model: every error names the dotted key.
 
-use super::spec::{BaseMotionSpec, ObjectSpec, PersonSpec, PushSpec, SceneSpec, ShapeSpec, SkinSpec, LidarSpec};
+use super::spec::{BaseMotionSpec, ObjectSpec, PersonSpec, PushSpec, SceneSpec, ShapeSpec, SkinSpec, LidarSpec, ViewSpec};
 
 /// A rejected value: its dotted key (e.g. `objects[2].shape.box.size_m`) and why.
 #[derive(Debug, Clone, PartialEq)]
@@ -55,12 +55,29 @@ fn rate(key: &str, hz: f64, timestep_s: f64) -> Checked {
     Ok(())
 }
 
+fn check_view(view: &ViewSpec, control_rate_hz: f64) -> Checked {
+    positive("view.fps", view.fps)?;
+    if view.fps > control_rate_hz {
+        return Err(reject("view.fps", format!("{} Hz: at most control_rate_hz ({control_rate_hz} Hz)", view.fps)));
+    }
+    if let Some(d) = view.distance_m {
+        positive("view.distance_m", d)?;
+    }
+    finite("view.lookat_m", &view.lookat_m.unwrap_or_default())?;
+    finite("view.azimuth_deg", &[view.azimuth_deg, view.elevation_deg])?;
+    if !(-90.0..=90.0).contains(&view.elevation_deg) {
+        return Err(reject("view.elevation_deg", format!("{}: within [-90, 90]", view.elevation_deg)));
+    }
+    Ok(())
+}
+
 /// Checks every value of `spec` that does not need the robot model.
 pub(crate) fn check_values(spec: &SceneSpec) -> Checked {
     positive("duration_s", spec.duration_s)?;
     positive("timestep_s", spec.timestep_s)?;
     rate("control_rate_hz", spec.control_rate_hz, spec.timestep_s)?;
     finite("floor_z_m", &[spec.floor_z_m])?;
+    check_view(&spec.view, spec.control_rate_hz)?;
     for (name, q) in &spec.robot.initial {
         finite(format!("robot.initial.{name}"), &[*q])?;
     }

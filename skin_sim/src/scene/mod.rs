@@ -76,6 +76,8 @@ pub struct Scene {
     pub q0: Vec<f64>,
     /// The skin, when the scene has one.
     pub skin: Option<SceneSkin>,
+    /// The URDF text of the robot (what `/robot_description` carries).
+    pub robot_description: String,
 }
 
 impl Scene {
@@ -95,7 +97,10 @@ impl Scene {
             reason: r.reason,
         };
         check::check_values(&spec).map_err(invalid)?;
-        let model = RobotModel::from_urdf_file(&resolve(dir, &spec.robot.urdf))
+        let urdf = resolve(dir, &spec.robot.urdf);
+        let robot_description = std::fs::read_to_string(&urdf)
+            .map_err(|e| invalid(reject("robot.urdf", format!("{}: {e}", urdf.display()))))?;
+        let model = RobotModel::from_urdf_str(&robot_description, &urdf.display().to_string())
             .map_err(|e| invalid(reject("robot.urdf", e.to_string())))?;
         let (moving, q0) = joint_setup(&spec.robot, &model).map_err(invalid)?;
         check_frames(&spec, &model).map_err(invalid)?;
@@ -114,6 +119,7 @@ impl Scene {
             moving,
             q0,
             skin,
+            robot_description,
         })
     }
 

@@ -51,6 +51,32 @@ pub struct SceneSpec {
     /// Seed of every random number of the run (sensor noise).
     #[serde(default)]
     pub seed: u64,
+    /// How the run is shown: camera and frame rate of the rendered frames and video.
+    #[serde(default)]
+    pub view: ViewSpec,
+}
+
+/// How a run is shown (`view:`): the camera of the rendered frames (MuJoCo's free camera) and
+/// the rate of the video frames and of the recording's `/tf` and `/skin/markers`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ViewSpec {
+    /// Point the camera looks at, world \[m\] (none: the centre of the model's bounding box).
+    pub lookat_m: Option<[f64; 3]>,
+    /// Distance of the camera from `lookat_m` \[m\] (none: 1.6 times the model's extent).
+    pub distance_m: Option<f64>,
+    /// Camera azimuth about the world z axis \[deg\] (90: looking along +y).
+    pub azimuth_deg: f64,
+    /// Camera elevation \[deg\] (negative: from above; -90: straight down).
+    pub elevation_deg: f64,
+    /// Frames per second of the view \[Hz\], at most the control rate.
+    pub fps: f64,
+}
+
+impl Default for ViewSpec {
+    fn default() -> Self {
+        ViewSpec { lookat_m: None, distance_m: None, azimuth_deg: 135.0, elevation_deg: -35.0, fps: 10.0 }
+    }
 }
 
 fn default_timestep() -> f64 {

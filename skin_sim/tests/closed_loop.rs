@@ -31,8 +31,17 @@ fn same_seed_gives_a_bit_identical_record() {
 #[test]
 fn metrics_json_has_the_keys_of_each_paper() {
     let always = ["realtime_factor", "sim_duration_s", "max_joint_speed_rad_s", "control_cycle_us_p50", "arrangement_switches"];
-    let paper000 = ["goal_reached", "goal_error_m", "max_contact_force_intentional_n", "eps_c_n", "hard_contact_recovery_s"];
-    let paper003 = ["force_mean_n", "rms_force_error_n", "rms_force_error_interaction_n"];
+    let paper000 = ["goal_reached", "goal_error_m", "max_contact_force_intentional_n", "eps_c_n", "hard_contact_recovery_s", "longest_contact_over_eps_c_s"];
+    let paper003 = [
+        "force_mean_n",
+        "rms_force_error_n",
+        "rms_force_error_interaction_n",
+        "rms_force_error_from_touch_n",
+        "rms_force_error_from_reach_n",
+        "force_rise_s",
+        "first_contact_peak_force_n",
+        "first_contact_reference_n",
+    ];
     let contact_free = ["max_link_contact_n", "eps_c_n"];
     for (name, keys) in [("intentional_contact", &paper000[..]), ("poster_phrc", &paper003[..]), ("tactile_guidance", &contact_free[..])] {
         let report = run(name, 0.5);

@@ -195,3 +195,19 @@ fn unknown_targets_are_refused_with_the_scenario_names() {
     let e = RunTarget::resolve("no_such_scenario", None).unwrap_err();
     assert!(e.contains("intentional_contact") && e.contains("no_such_scenario"), "{e}");
 }
+
+/// A force scene run under another name (no scenario targets) still checks what every force
+/// scene must show: cut before the hand touches, its from-touch RMS is NaN and the run fails.
+#[test]
+fn a_renamed_force_scene_that_never_touches_fails() {
+    let s = scenario::find("poster_phrc").unwrap();
+    let target = RunTarget { name: "renamed_copy".into(), force_targets: None, ..RunTarget::from(s) };
+    // the force reference starts at 27 s; the hand touches the wall about 3 s later
+    let overrides = RunOverrides { duration_s: Some(28.0), ..RunOverrides::default() };
+    let report = target.run(&overrides, |_| {}).unwrap();
+    let f = report.metrics.force.as_ref().expect("force metrics");
+    assert!(f.rms_force_error_from_touch_n.is_nan(), "{f:?}");
+    let failed: Vec<&str> = report.checks.iter().filter(|c| !c.passed).map(|c| c.name).collect();
+    assert!(failed.contains(&"force tracked from the touch (finite RMS)"), "{failed:?}");
+    assert!(!report.passed());
+}

@@ -342,7 +342,7 @@ pub fn first_contact_peak(contact: &[&CycleRecord]) -> (f64, f64) {
     let mut peak = (f64::NAN, f64::NAN);
     let mut reached = false;
     for c in contact {
-        if !(c.hand_force_n <= peak.0) {
+        if peak.0.is_nan() || c.hand_force_n > peak.0 {
             peak = (c.hand_force_n, c.force_reference_n);
         }
         let over = c.hand_force_n > c.force_reference_n;

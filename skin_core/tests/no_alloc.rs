@@ -362,7 +362,7 @@ fn tasks_do_not_allocate_after_setup() {
         orient.update(&model, data, &goal_r, l1).unwrap();
         avoid.update(&model, data, &layout, &live, 0.08, l2).unwrap();
         contact.update(&model, data, &layout, &live, &skin.fusion, l3).unwrap();
-        hand_task.update(&model, data, HandMeasurement::Force { fused_signal: 0.1 }, &skin.proximity, l4).unwrap();
+        hand_task.update(&model, data, HandMeasurement::Force { fused_signal: 0.1 }, 0.0, &skin.proximity, l4).unwrap();
         wrist.update(&model, data, &gamma, l5).unwrap();
         guide.update(&model, data, &h_f, l6).unwrap();
         hold.update(&model, data, l7).unwrap();

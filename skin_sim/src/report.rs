@@ -51,12 +51,17 @@ impl RunReport {
         if let Some(f) = &m.force {
             let _ = writeln!(
                 s,
-                "  hand force mean {:.3} N, RMS error {:.3} N w/o interaction ({} cycles), {:.3} N with ({} cycles), out of contact {:.1} %",
+                "  hand force mean {:.3} N, RMS error from touch {:.3} N w/o interaction, from reaching the reference {:.3} N (rise {:.2} s), settled {:.3} N ({} cycles), {:.3} N with ({} cycles), first-touch peak {:.2} N (reference {:.2} N), out of contact {:.1} %",
                 f.force_mean_n,
+                f.rms_force_error_from_touch_n,
+                f.rms_force_error_from_reach_n,
+                f.force_rise_s,
                 f.rms_force_error_n,
                 f.rms_cycles[0],
                 f.rms_force_error_interaction_n,
                 f.rms_cycles[1],
+                f.first_contact_peak_force_n,
+                f.first_contact_reference_n,
                 100.0 * f.contact_lost_fraction
             );
         }

@@ -31,8 +31,17 @@ fn same_seed_gives_a_bit_identical_record() {
 #[test]
 fn metrics_json_has_the_keys_of_each_paper() {
     let always = ["realtime_factor", "sim_duration_s", "max_joint_speed_rad_s", "control_cycle_us_p50", "arrangement_switches"];
-    let paper000 = ["goal_reached", "goal_error_m", "max_contact_force_intentional_n", "eps_c_n", "hard_contact_recovery_s"];
-    let paper003 = ["force_mean_n", "rms_force_error_n", "rms_force_error_interaction_n"];
+    let paper000 = ["goal_reached", "goal_error_m", "max_contact_force_intentional_n", "eps_c_n", "hard_contact_recovery_s", "longest_contact_over_eps_c_s"];
+    let paper003 = [
+        "force_mean_n",
+        "rms_force_error_n",
+        "rms_force_error_interaction_n",
+        "rms_force_error_from_touch_n",
+        "rms_force_error_from_reach_n",
+        "force_rise_s",
+        "first_contact_peak_force_n",
+        "first_contact_reference_n",
+    ];
     let contact_free = ["max_link_contact_n", "eps_c_n"];
     for (name, keys) in [("intentional_contact", &paper000[..]), ("poster_phrc", &paper003[..]), ("tactile_guidance", &contact_free[..])] {
         let report = run(name, 0.5);
@@ -185,4 +194,20 @@ fn the_hand_force_map_is_n_cells_sharing_the_force() {
 fn unknown_targets_are_refused_with_the_scenario_names() {
     let e = RunTarget::resolve("no_such_scenario", None).unwrap_err();
     assert!(e.contains("intentional_contact") && e.contains("no_such_scenario"), "{e}");
+}
+
+/// A force scene run under another name (no scenario targets) still checks what every force
+/// scene must show: cut before the hand touches, its from-touch RMS is NaN and the run fails.
+#[test]
+fn a_renamed_force_scene_that_never_touches_fails() {
+    let s = scenario::find("poster_phrc").unwrap();
+    let target = RunTarget { name: "renamed_copy".into(), force_targets: None, ..RunTarget::from(s) };
+    // the force reference starts at 27 s; the hand touches the wall about 3 s later
+    let overrides = RunOverrides { duration_s: Some(28.0), ..RunOverrides::default() };
+    let report = target.run(&overrides, |_| {}).unwrap();
+    let f = report.metrics.force.as_ref().expect("force metrics");
+    assert!(f.rms_force_error_from_touch_n.is_nan(), "{f:?}");
+    let failed: Vec<&str> = report.checks.iter().filter(|c| !c.passed).map(|c| c.name).collect();
+    assert!(failed.contains(&"force tracked from the touch (finite RMS)"), "{failed:?}");
+    assert!(!report.passed());
 }

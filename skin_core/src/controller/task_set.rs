@@ -225,11 +225,11 @@ impl TaskSet {
             }
             TaskKind::HandDistance => {
                 let m = HandMeasurement::Distance { proximity_signal: cx.hand.proximity };
-                self.hand.update(model, data, m, &skin.proximity, level)?;
+                self.hand.update(model, data, m, cx.hand.proximity, &skin.proximity, level)?;
             }
             TaskKind::HandForce => {
                 let m = HandMeasurement::Force { fused_signal: cx.hand.fused_force };
-                self.hand.update(model, data, m, &skin.proximity, level)?;
+                self.hand.update(model, data, m, cx.hand.proximity, &skin.proximity, level)?;
             }
             TaskKind::Wrist => {
                 self.wrist.update(model, data, &cx.hand.moment_world, level)?;

@@ -32,6 +32,31 @@ impl Dwell {
     }
 }
 
+/// The goal error at the start of the current progress window, and whether the last full
+/// window made too little progress (a crawl that the speed test misses).
+#[derive(Debug, Clone, Copy)]
+struct Progress {
+    since: f64,
+    error_m: f64,
+    crawling: bool,
+}
+
+impl Progress {
+    const IDLE: Progress = Progress { since: f64::NAN, error_m: f64::NAN, crawling: false };
+
+    /// Advances to `t` with the goal error `e`; NaN restarts the window.
+    fn step(&mut self, t: f64, e: f64, window_s: f64, min_m: f64) -> bool {
+        if e.is_nan() || self.since.is_nan() {
+            *self = Progress { since: if e.is_nan() { f64::NAN } else { t }, error_m: e, crawling: false };
+        } else if t - self.since >= window_s {
+            self.crawling = self.error_m - e < min_m;
+            self.since = t;
+            self.error_m = e;
+        }
+        self.crawling
+    }
+}
+
 /// The priority supervisor. Allocates in [`Supervisor::new`] only.
 #[derive(Debug, Clone)]
 pub struct Supervisor {
@@ -51,6 +76,7 @@ pub struct Supervisor {
     goal_reached: Dwell,
     cleared: Dwell,
     invalid: Dwell,
+    progress: Progress,
     pending: Option<Phase>,
     weight: WeightShift,
     last_t: f64,
@@ -100,6 +126,7 @@ impl Supervisor {
             goal_reached: Dwell::IDLE,
             cleared: Dwell::IDLE,
             invalid: Dwell::IDLE,
+            progress: Progress::IDLE,
             pending: None,
             weight: WeightShift::constant(w),
             last_t: t0,
@@ -238,10 +265,13 @@ impl Supervisor {
                     return;
                 }
                 if mode == Mode::Avoidance {
-                    let set = v <= th.speed_mps
+                    // Stopped: slower than ε_v, or crawling without getting nearer the goal
+                    // (a NaN speed is never stopped).
+                    let crawl = self.progress.step(t, ge, th.progress_window_s, th.progress_min_m) && !v.is_nan();
+                    let set = (v <= th.speed_mps || crawl)
                         && fd > th.obstacle_force_n + th.obstacle_band_n
                         && ge > th.goal_tolerance_m + th.goal_band_m;
-                    let keep = v <= th.speed_mps + th.speed_band_mps
+                    let keep = (v <= th.speed_mps + th.speed_band_mps || crawl)
                         && fd > th.obstacle_force_n
                         && ge > th.goal_tolerance_m;
                     if self.stuck.step(t, set, keep, dw.stuck_s) {
@@ -337,6 +367,7 @@ impl Supervisor {
         ] {
             *d = Dwell::IDLE;
         }
+        self.progress = Progress::IDLE;
         let tr = Transition {
             t_s: t,
             from,

@@ -72,6 +72,12 @@ pub struct Thresholds {
     pub goal_tolerance_m: f64,
     /// [m] the goal counts as not reached for the stuck test when the error is `>` tol + band.
     pub goal_band_m: f64,
+    /// [s] window of the progress test: moving but not getting nearer the goal (a crawl along an
+    /// obstacle faster than ε_v) counts as stopped when the goal error fell by less than
+    /// `progress_min_m` over this long.
+    pub progress_window_s: f64,
+    /// [m] least fall of the goal error over `progress_window_s` that counts as progress.
+    pub progress_min_m: f64,
 }
 
 /// How long a condition must hold before its switch [s] (all `≥ 0`).
@@ -227,6 +233,8 @@ impl SupervisorParams {
         non_negative(p, "obstacle_band_n", t.obstacle_band_n)?;
         InvalidParam::positive_finite(p, "goal_tolerance_m", t.goal_tolerance_m)?;
         non_negative(p, "goal_band_m", t.goal_band_m)?;
+        InvalidParam::positive_finite(p, "progress_window_s", t.progress_window_s)?;
+        non_negative(p, "progress_min_m", t.progress_min_m)?;
 
         let d = &self.dwell;
         let p = "dwell.";

@@ -110,8 +110,13 @@ fn stuck_switches_a_to_b_after_dwell() {
 #[test]
 fn no_switch_to_b_when_moving_or_clear_or_at_goal() {
     let p = params();
+    // moving for less than one progress window (moving toward the goal for longer:
+    // `a_crawl_without_goal_progress_is_stuck`)
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    let within = (p.thresholds.progress_window_s / DT) as usize - 1;
+    assert!(run(&mut sup, &mut t, within, input(0.05, 3.0, 0.0, 0.2)).is_empty());
     for u in [
-        input(0.05, 3.0, 0.0, 0.2),  // moving
         input(0.0, 0.0, 0.0, 0.2),   // nothing in range
         input(0.0, 3.0, 0.0, 0.005), // goal reached
     ] {
@@ -724,4 +729,28 @@ fn follower_reproduces_the_deciding_supervisor() {
     let mut s = Supervisor::new(&params(), 0.0).unwrap();
     let bad = Imposed { mode: Mode::Avoidance, switch_time_s: f64::NAN, sensing_range_m: 0.1, fusion_weight_target: 0.0 };
     assert!(s.impose(bad).is_err());
+}
+
+/// A crawl along an obstacle, faster than ε_v but not getting nearer the goal, counts as stuck
+/// after the progress window (and the stuck dwell); the same speed with the goal error falling
+/// faster than `progress_min_m` per window never does.
+#[test]
+fn a_crawl_without_goal_progress_is_stuck() {
+    let p = params();
+    let th = p.thresholds;
+    let crawl_speed = 3.0 * th.speed_mps;
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    let steps = |s: f64| (s / DT).ceil() as usize;
+    // the goal error falls by 2 progress_min_m per window: progress
+    let rate = 2.0 * th.progress_min_m / th.progress_window_s;
+    for _ in 0..steps(4.0 * th.progress_window_s) {
+        t += DT;
+        sup.update(t, &input(crawl_speed, 3.0, 0.0, 0.5 - rate * t));
+        assert_eq!(sup.last_transition(), None, "progress is not a local minimum (t = {t})");
+    }
+    // then it crawls at the same speed without progress
+    let tr = run(&mut sup, &mut t, steps(2.0 * th.progress_window_s + p.dwell.stuck_s), input(crawl_speed, 3.0, 0.0, 0.3));
+    assert_eq!(tr.len(), 1, "{tr:?}");
+    assert_eq!((tr[0].to, tr[0].cause), (Mode::IntentionalContact, Cause::Stuck));
 }

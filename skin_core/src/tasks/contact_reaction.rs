@@ -2,7 +2,9 @@
 //!
 //! Sign choice: the touching object is outside the link, along the cell's outward normal `+n_i`;
 //! the measured contact force on the robot points inward (`−n_i`). The reaction yields to the
-//! contact: its task force `F_ci = min(gain · F_i, F_max)` acts along `−n_i`, i.e. the row is
+//! contact: its task force `F_ci = gain · F_i`, the measured cell force as eq. (6) prints it times a
+//! documented gain (no cap: a harder contact is met with a harder reaction), acts along `−n_i`,
+//! i.e. the row is
 //! `(−n_i)ᵀ J_v(p_i)` with a positive force, so the touched point accelerates away from the object
 //! (`n_iᵀ J_v M⁻¹ τ < 0` at rest), relieving the contact. `F_i` \[N\] comes from the inverse force
 //! characteristic of the cell's force signal, for cells above the activity threshold. A row's
@@ -21,7 +23,7 @@ use crate::skin::live::LiveCells;
 /// Contact reaction over all cells of a layout.
 #[derive(Debug, Clone)]
 pub struct ContactReaction {
-    /// Gain and saturation.
+    /// Gain and row activation.
     pub params: ContactReactionParams,
     /// The cells' force characteristic (signal to newtons), prepared once.
     force: PreparedForce,
@@ -96,7 +98,7 @@ impl ContactReactionParams {
                 continue;
             }
             let measured = force.force_n(sig);
-            let f = (self.gain * measured).min(self.max_force_n);
+            let f = self.gain * measured;
             row(&layout.cells()[*i], (f, row_activation(measured, self.activation_force_n)))?;
             s.rows += 1;
             s.max_force_n = s.max_force_n.max(f);

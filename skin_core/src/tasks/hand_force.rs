@@ -10,6 +10,14 @@
 //!
 //! Either way a positive `Δ` (too little force, too far away) accelerates the hand along `+z_h`,
 //! into the surface. The drift is `J̇q̇ = z_h·a_lin + (ω × z_h)·v`.
+//!
+//! No impact at the first touch: eq. (9) alone lets the hand reach the surface with whatever
+//! speed the force error built up on the way (a 6 N reference peaked at 18 N). The closing speed
+//! `ż_h` is therefore bounded by the distance the hand's proximity senses,
+//! `ż_h ≤ v_0 + d / T_a` ([`approach_speed_limit`]): the hand slows down as the surface comes
+//! near and touches it at most at `v_0`. The bound acts as a braking acceleration
+//! `(v_lim − ż_h) / T_b` that replaces eq. (9)'s when it is lower; it never pushes, so it changes
+//! nothing while the hand is slower than the bound (in contact and holding a force, `ż_h ≈ 0`).
 
 use nalgebra::Vector3;
 
@@ -33,6 +41,15 @@ pub enum HandMeasurement {
         /// Proximity signal \[0, 1\].
         proximity_signal: f64,
     },
+}
+
+/// Time constant of the braking toward the approach bound \[s\] (a few control cycles).
+pub const APPROACH_BRAKE_S: f64 = 0.02;
+
+/// The largest closing speed toward a surface sensed `distance_m` ahead \[m/s\]:
+/// `v_0 + d / T_a` (a surface out of the proximity range reads as the range).
+pub fn approach_speed_limit(params: &HandForceParams, distance_m: f64) -> f64 {
+    params.approach_speed_min_mps + distance_m.max(0.0) / params.approach_time_s
 }
 
 /// Hand force/distance task.
@@ -63,12 +80,15 @@ impl HandForce {
         }
     }
 
-    /// Fills `level` (1 acceleration row); returns `ẍ*`.
+    /// Fills `level` (1 acceleration row); returns `ẍ*`. `proximity_signal` is the hand's
+    /// proximity (largest over the hand patch): it bounds the closing speed in either mode.
+    #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
         model: &RobotModel,
         data: &ModelData,
         measurement: HandMeasurement,
+        proximity_signal: f64,
         proximity: &ProximityCharacteristic,
         level: &mut TaskLevel,
     ) -> Result<f64, TaskError> {
@@ -78,7 +98,10 @@ impl HandForce {
         let w = self.rows.velocity(ANGULAR, data.qd());
         let a = self.rows.drift(LINEAR);
         let jdot_qdot = z.dot(&a) + w.cross(&z).dot(&v);
-        let xdd = (self.error(measurement, proximity) - self.params.d_n_s_per_m * z.dot(&v)) / self.params.lambda_kg;
+        let closing = z.dot(&v);
+        let eq9 = (self.error(measurement, proximity) - self.params.d_n_s_per_m * closing) / self.params.lambda_kg;
+        let limit = approach_speed_limit(&self.params, proximity.distance_m(proximity_signal));
+        let xdd = eq9.min((limit - closing) / APPROACH_BRAKE_S);
         level.clear();
         level.push_directional(
             z.as_slice(),

@@ -37,10 +37,8 @@ pub struct AvoidanceParams {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactReactionParams {
-    /// Dimensionless gain on the measured cell force.
+    /// Dimensionless gain on the measured cell force of eq. (6).
     pub gain: f64,
-    /// Saturation of the per-cell task force \[N\].
-    pub max_force_n: f64,
     /// Measured cell force at which a contact row is fully active in the null-space projector
     /// \[N\] (activation rises smoothly from 0 at no force). 0: rows switch on at once.
     pub activation_force_n: f64,
@@ -63,6 +61,12 @@ pub struct HandForceParams {
     pub force_signal_desired: f64,
     /// Desired distance `d_p,d` \[m\] (approach phase, Table 1).
     pub distance_desired_m: f64,
+    /// Approach speed bound: the hand may close on a sensed surface at most at
+    /// `approach_speed_min_mps + d / approach_time_s`, `d` the distance its proximity reads
+    /// (see [`super::hand_force::approach_speed_limit`]) \[s\].
+    pub approach_time_s: f64,
+    /// Closing speed still allowed at `d = 0` (touching) \[m/s\].
+    pub approach_speed_min_mps: f64,
 }
 
 /// Impedance of a 3-row acceleration task, paper 003 eq. (4)/(5): diagonals of `Λ`, `K`, `D`.
@@ -192,7 +196,6 @@ impl TaskParams {
         nonneg("avoidance.", "range_m", self.avoidance.range_m)?;
         nonneg("avoidance.", "activation_band_m", self.avoidance.activation_band_m)?;
         nonneg("contact_reaction.", "gain", self.contact_reaction.gain)?;
-        pos("contact_reaction.", "max_force_n", self.contact_reaction.max_force_n)?;
         nonneg("contact_reaction.", "activation_force_n", self.contact_reaction.activation_force_n)?;
         let h = &self.hand_force;
         pos("hand_force.", "lambda_kg", h.lambda_kg)?;
@@ -201,6 +204,8 @@ impl TaskParams {
         nonneg("hand_force.", "d_n_s_per_m", h.d_n_s_per_m)?;
         InvalidParam::in_range("hand_force.", "force_signal_desired", h.force_signal_desired, 0.0, f64::MAX, "must be finite and >= 0")?;
         nonneg("hand_force.", "distance_desired_m", h.distance_desired_m)?;
+        pos("hand_force.", "approach_time_s", h.approach_time_s)?;
+        pos("hand_force.", "approach_speed_min_mps", h.approach_speed_min_mps)?;
         self.wrist.validate("wrist.")?;
         self.tactile_guidance.validate("tactile_guidance.")?;
         self.position_hold.validate("position_hold.")?;

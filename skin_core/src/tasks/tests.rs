@@ -10,7 +10,7 @@ use super::base_avoidance::BaseAvoidance;
 use super::contact_reaction::ContactReaction;
 use super::goal::{saturated_goal_force, GoalOrientation, GoalPosition};
 use super::hand_force::{HandForce, HandMeasurement};
-use super::params::TaskParams;
+use super::params::{HandForceParams, TaskParams};
 use crate::param_file::ParamsError;
 use super::position_hold::PositionHold;
 use super::posture::{BaseReference, Posture};
@@ -189,7 +189,8 @@ fn contact_reaction_moves_touched_cell_along_minus_n() {
     let mut level = TaskLevel::new("contact", s.model.nv(), n);
     let sum = task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), &s.skin.fusion, &mut level).unwrap();
     assert_eq!(level.rows(), 1);
-    let expected = (s.params.contact_reaction.gain * s.skin.force.force_n(0.5)).min(s.params.contact_reaction.max_force_n);
+    // eq. (6): the measured force times the gain, uncapped
+    let expected = s.params.contact_reaction.gain * s.skin.force.force_n(0.5);
     assert_relative_eq!(sum.max_force_n, expected, epsilon = 1e-9);
     let cell = s.layout.cells()[c].clone();
     let nw = s.data.frame_pose(cell.frame).rotation * cell.normal_link;
@@ -199,6 +200,43 @@ fn contact_reaction_moves_touched_cell_along_minus_n() {
     assert!((j.fixed_rows::<3>(0) * qdd).dot(&nw) < 0.0);
 }
 
+/// The closing speed bound of the hand task: a hand moving into a surface faster than
+/// `v_0 + d / T_a` brakes whatever eq. (9) asks for, the bound falls with the sensed distance, and
+/// a hand slower than it gets eq. (9) unchanged.
+#[test]
+fn hand_approach_speed_is_bounded_by_the_sensed_distance() {
+    let mut s = tomm();
+    let hand = s.model.frame_index("right_hand").unwrap();
+    // undamped eq. (9), so that only the bound can brake
+    let h = HandForceParams { d_n_s_per_m: 0.0, ..s.params.hand_force };
+    let mut task = HandForce::new(s.model.nv(), hand, h);
+    let mut level = TaskLevel::new("hand", s.model.nv(), 1);
+    let mut j = Matrix6xX::zeros(s.model.nv());
+    point_jacobian(&s.model, &s.data, hand, &Vector3::zeros(), &mut j).unwrap();
+    let z = s.data.frame_pose(hand).rotation * Vector3::z();
+    // joint velocities that move the hand along +z_h at `speed` (least squares through J_v^T)
+    let row = (z.transpose() * j.fixed_rows::<3>(0)).transpose();
+    let moving = |speed: f64| row.clone() * (speed / row.norm_squared());
+    let far = HandMeasurement::Force { fused_signal: 0.0 };
+    let near = s.skin.proximity.signal(0.01);
+    let limit_near = super::hand_force::approach_speed_limit(&h, 0.01);
+    assert_relative_eq!(limit_near, h.approach_speed_min_mps + 0.01 / h.approach_time_s, epsilon = 1e-9);
+    // faster than the bound at 1 cm: brakes although the force error pushes
+    let qd = moving(2.0 * limit_near);
+    update_kinematics(&s.model, &mut s.data, &s.q, qd.as_slice()).unwrap();
+    let xdd = task.update(&s.model, &s.data, far, near, &s.skin.proximity, &mut level).unwrap();
+    assert!(xdd < 0.0, "braking expected, got {xdd}");
+    assert_relative_eq!(xdd, -limit_near / super::hand_force::APPROACH_BRAKE_S, max_relative = 1e-6);
+    // the same speed with nothing in range is below the bound: eq. (9) as it is
+    let xdd = task.update(&s.model, &s.data, far, 0.0, &s.skin.proximity, &mut level).unwrap();
+    assert_relative_eq!(xdd, h.k_force_n_per_signal * h.force_signal_desired / h.lambda_kg, max_relative = 1e-6);
+    // retreating is never bounded
+    let qd = moving(-0.2);
+    update_kinematics(&s.model, &mut s.data, &s.q, qd.as_slice()).unwrap();
+    let xdd = task.update(&s.model, &s.data, far, 1.0, &s.skin.proximity, &mut level).unwrap();
+    assert!(xdd > 0.0);
+}
+
 #[test]
 fn hand_force_sign_and_row() {
     let s = tomm();
@@ -206,15 +244,15 @@ fn hand_force_sign_and_row() {
     let mut task = HandForce::new(s.model.nv(), hand, s.params.hand_force);
     let mut level = TaskLevel::new("hand", s.model.nv(), 1);
     // force below the reference: accelerate into the surface (+z_h)
-    let xdd = task.update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.0 }, &s.skin.proximity, &mut level).unwrap();
+    let xdd = task.update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.0 }, 0.0, &s.skin.proximity, &mut level).unwrap();
     assert!(xdd > 0.0);
     let h = s.params.hand_force;
     assert_relative_eq!(xdd, h.k_force_n_per_signal * h.force_signal_desired / h.lambda_kg, epsilon = 1e-12);
     // too much force: back off
-    let xdd = task.update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.9 }, &s.skin.proximity, &mut level).unwrap();
+    let xdd = task.update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.9 }, 0.0, &s.skin.proximity, &mut level).unwrap();
     assert!(xdd < 0.0);
     // far away in distance mode: approach
-    let xdd = task.update(&s.model, &s.data, HandMeasurement::Distance { proximity_signal: 0.05 }, &s.skin.proximity, &mut level).unwrap();
+    let xdd = task.update(&s.model, &s.data, HandMeasurement::Distance { proximity_signal: 0.05 }, 0.05, &s.skin.proximity, &mut level).unwrap();
     assert!(xdd > 0.0);
     // the row is z_hᵀ J_v
     let mut j = Matrix6xX::zeros(s.model.nv());
@@ -375,7 +413,7 @@ fn three_tasks_and_posture_through_the_solver() {
     let [l0, l1, l2] = &mut levels;
     let sum = avoid.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), 0.1, l0).unwrap();
     assert!(sum.rows > 0);
-    hand_task.update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.1 }, &s.skin.proximity, l1).unwrap();
+    hand_task.update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.1 }, 0.0, &s.skin.proximity, l1).unwrap();
     hold.update(&s.model, &s.data, l2).unwrap();
     let tau_c = posture.update(&s.model, &s.data, &s.layout, &wrenches, |_| true, None, true).unwrap().clone();
     let mut solver = HierarchySolver::new(nv, 3, n, InverseParams::default()).unwrap();

@@ -63,3 +63,13 @@ def test_sim_launch_covers_the_graph():
     for exe in ("mujoco_sim", "task_controller", "priority_supervisor", "skin_aggregator", "robot_state_publisher"):
         assert f'executable="{exe}"' in text
     assert (TOP / "config" / "skin.rviz").read_text().count("/skin/markers") == 1
+
+
+def test_the_launch_files_start_the_watchdog_and_activate_only_the_simulation():
+    for name, autostart in (("tomm.launch.py", "false"), ("sim.launch.py", "true")):
+        tree = ast.parse((TOP / "launch" / name).read_text())
+        exes = [const(k.value) for c in calls(tree, "Node") for k in c.keywords if k.arg == "executable"]
+        assert "skin_watchdog" in exes and "task_controller" in exes, (name, exes)
+        defaults = {const(c.args[0]): const(k.value) for c in calls(tree, "DeclareLaunchArgument")
+                    for k in c.keywords if k.arg == "default_value"}
+        assert defaults.get("autostart") == autostart, (name, defaults)

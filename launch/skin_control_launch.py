@@ -74,19 +74,28 @@ def mounted_description(urdf_text):
     return ET.tostring(root, encoding="unicode")
 
 
-def graph_nodes(namespace, description, sim_time, trigger="timer", controller=None):
-    """task_controller (with the parameters `controller` on top), priority_supervisor,
+def graph_nodes(namespace, description, sim_time, trigger="timer", controller=None, watchdog=None):
+    """task_controller (with the parameters `controller` on top; activated at start when the
+    launch argument `autostart` is true), skin_watchdog in timer mode (arguments `watchdog`, by
+    default the command topics the controller's heartbeat names), priority_supervisor,
     skin_aggregator for `description` (a describe() result), robot_state_publisher and RViz when
     the launch arguments `robot_state_publisher` and `rviz` say so; every node but RViz in
     `namespace`."""
     setup = description["setup"]
     time = {"use_sim_time": sim_time}
     urdf_text = open(description["urdf"]).read()
-    return [
+    autostart = ParameterValue(LaunchConfiguration("autostart"), value_type=bool)
+    # Zeros on the command topics when the controller's heartbeat stops; not in lockstep, where
+    # the simulation waits for the controller. Sim time: a wider timeout.
+    guard = [] if trigger != "timer" else [
+        Node(package=PKG, executable="skin_watchdog", name="skin_watchdog", namespace=namespace, output="screen",
+             arguments=watchdog or ["--learn-topics", "--timeout-s", "0.1"])]
+    return guard + [
         Node(package=PKG, executable="task_controller", name="task_controller", namespace=namespace,
              output="screen",
              parameters=[share_file("config", "ros", "task_controller.yaml"), time,
-                         {"setup_file": setup, "trigger": trigger, "use_scan": description["lidar"]},
+                         {"setup_file": setup, "trigger": trigger, "use_scan": description["lidar"],
+                          "autostart": autostart},
                          controller or {}]),
         Node(package=PKG, executable="priority_supervisor", name="priority_supervisor", namespace=namespace,
              output="screen",

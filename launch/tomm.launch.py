@@ -126,7 +126,10 @@ def launch_setup(context):
                               arguments=["--frame-id", "world", "--child-frame-id", "odom"]))
     # The command namespaces of the arms, as the drivers (or the simulator) serve them.
     commands = {"arms.namespaces": namespaces, "arms.joint_prefixes": [a["tf_prefix"] for a in arm_list]}
-    return robot + graph_nodes(ns, description, sim_time=sim, controller=commands)
+    # The watchdog zeroes the arms' and the base's command topics from the start (relative: in ns).
+    watchdog = [x for n in namespaces for x in ("--arm", f"{n}/forward_velocity_controller/commands=6")]
+    return robot + graph_nodes(ns, description, sim_time=sim, controller=commands,
+                               watchdog=watchdog + (["--timeout-s", "0.1"] if sim else []))
 
 
 def generate_launch_description():
@@ -135,6 +138,8 @@ def generate_launch_description():
         ("scene", "tomm_movable_obstacles", "hardware:=sim: the TOMM scene to simulate"),
         ("setup", "", "controller setup file (default: config/controller/tomm.yaml; sim: the scenario's)"),
         ("namespace", "", "namespace of the whole graph"),
+        ("autostart", "false", "activate task_controller at start (else: ros2 lifecycle set <ns>/task_controller "
+                               "configure, then activate; hardware:=sim defaults to it too)"),
         ("ur_type", "ur5", "UR type of both arms (ur_robot_driver)"),
         ("ur_description_file", "", "the UR description xacro (default: ur_robot_driver's urdf/ur.urdf.xacro)"),
         ("headless_mode", "false", "ur_robot_driver headless mode"),

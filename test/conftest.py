@@ -10,8 +10,9 @@ import pytest
 TOP = Path(__file__).resolve().parent.parent
 
 # A DDS domain of this test session's own (inherited by every node it starts): graphs of other
-# sessions on the same machine (a demo, a second checkout's tests) must not cross-talk.
-os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
+# sessions on the same machine (a demo, a second checkout's tests) must not cross-talk. Set
+# whatever the shell had (.deps/env.sh sets 57 for every shell, so a default would never apply).
+os.environ["ROS_DOMAIN_ID"] = str(1 + os.getpid() % 100)
 
 
 def target_dir() -> Path:

@@ -90,7 +90,8 @@ def test_controller_graph(spawn, rclpy_node):
 
     layout = yaml.safe_load((TOP / "config" / "skin" / "tomm.yaml").read_text())
     forearm_cell = next(c["id"] for c in layout["cells"] if c["patch"] == 8)
-    tc = spawn(binary("task_controller"), "--ros-args", "--params-file", TOP / "config/ros/task_controller.yaml")
+    tc = spawn(binary("task_controller"), "--ros-args", "--params-file", TOP / "config/ros/task_controller.yaml",
+               "-p", "autostart:=true")
     sup = spawn(binary("priority_supervisor"), "--ros-args", "--params-file",
                 TOP / "config/ros/priority_supervisor.yaml")
     agg = spawn(binary("skin_aggregator"), "--ros-args", "--params-file", TOP / "config/ros/skin_aggregator.yaml")

@@ -204,7 +204,7 @@ def test_graph_survives_faults(spawn, rclpy_node):
     forearm = [c["id"] for c in layout["cells"] if c["patch"] == 8]
     params = ["--ros-args", "--params-file"]
     tc = spawn(binary("task_controller"), *params, TOP / "config/ros/task_controller.yaml",
-               "-p", "input_timeout_s:=0.15")
+               "-p", "input_timeout_s:=0.15", "-p", "autostart:=true")
 
     def start_peers():
         return (spawn(binary("priority_supervisor"), *params, TOP / "config/ros/priority_supervisor.yaml"),

@@ -63,3 +63,17 @@ def test_the_rviz_config_shows_the_markers():
     rviz = yaml.safe_load((TOP / "config" / "skin.rviz").read_text())
     topics = [d.get("Topic", {}).get("Value") for d in rviz["Visualization Manager"]["Displays"]]
     assert "/skin/markers" in topics
+
+
+def test_the_launch_files_start_the_watchdog_and_activate_only_the_simulation():
+    shared = ast.parse((TOP / "launch" / "skin_control_launch.py").read_text())
+    exes = [const(k.value) for c in calls(shared, "Node") for k in c.keywords if k.arg == "executable"]
+    assert "skin_watchdog" in exes and "task_controller" in exes, exes
+    sim = ast.parse((TOP / "skin_sim_ros" / "launch" / "sim.launch.py").read_text())
+    defaults = {const(c.args[0]): const(k.value) for c in calls(sim, "DeclareLaunchArgument")
+                for k in c.keywords if k.arg == "default_value"}
+    assert defaults.get("autostart") == "true", defaults
+    tomm = ast.parse((TOP / "launch" / "tomm.launch.py").read_text())
+    args = {const(t.elts[0]): const(t.elts[1]) for t in ast.walk(tomm)
+            if isinstance(t, ast.Tuple) and len(t.elts) == 3 and all(const(e) is not None for e in t.elts[:2])}
+    assert args.get("autostart") == "false", args

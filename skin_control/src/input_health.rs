@@ -32,27 +32,46 @@ impl StampIssue {
 }
 
 /// The stamp check of one timed input: its messages must not go back in time nor run ahead of
-/// the clock.
+/// the clock. Only accepted messages ([`StampGate::accept`]) set the order.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct StampGate {
     last_s: Option<f64>,
 }
 
 impl StampGate {
-    /// Accepts `stamp` unless it is older than the last accepted one, or more than `max_lead_s`
-    /// ahead of `now_s` (`None`: no clock to compare with, as in lockstep). An equal stamp is
-    /// accepted: a resent period.
-    pub fn check(&mut self, stamp: &Time, now_s: Option<f64>, max_lead_s: f64) -> Result<(), StampIssue> {
+    /// Checks `stamp`: refused when more than `max_lead_s` ahead of `now_s` (`None`: no clock to
+    /// compare with, as in lockstep), or older than the last accepted one. A last stamp that is
+    /// itself ahead of the clock by more than `max_lead_s` (the clock went back) holds nothing
+    /// back. An equal stamp passes: a resent period.
+    pub fn check(&self, stamp: &Time, now_s: Option<f64>, max_lead_s: f64) -> Result<(), StampIssue> {
         let t = time_s(stamp);
-        if self.last_s.is_some_and(|last| t < last) {
-            return Err(StampIssue::OutOfOrder);
-        }
-        if now_s.is_some_and(|now| t > now + max_lead_s) {
+        let limit = now_s.map_or(f64::INFINITY, |now| now + max_lead_s);
+        if t > limit {
             return Err(StampIssue::Future);
         }
-        self.last_s = Some(t);
+        if self.last_s.is_some_and(|last| t < last && last <= limit) {
+            return Err(StampIssue::OutOfOrder);
+        }
         Ok(())
     }
+
+    /// Records `stamp` as the last accepted one (a message that passed [`Self::check`] and was
+    /// used).
+    pub fn accept(&mut self, stamp: &Time) {
+        self.last_s = Some(time_s(stamp));
+    }
+
+    /// The last accepted stamp \[s\].
+    pub fn last(&self) -> Option<f64> {
+        self.last_s
+    }
+}
+
+/// Whether an input of `age_s` (clock minus stamp) is fresh: in `[-max_lead_s, timeout_s]`.
+/// A negative age beyond the lead (the clock went back, or a stamp that passed when the clock
+/// was ahead) is not fresh: the input's value may be from any time.
+pub fn fresh(age_s: f64, timeout_s: f64, max_lead_s: f64) -> bool {
+    (-max_lead_s..=timeout_s).contains(&age_s)
 }
 
 /// Counters of bad input, one per `"<topic>: <kind>"`, in the fixed order of registration.
@@ -127,12 +146,31 @@ mod tests {
     #[test]
     fn stamps_must_not_go_back_nor_run_ahead() {
         let mut gate = StampGate::default();
-        assert_eq!(gate.check(&time_msg(10.0), Some(10.0), 0.05), Ok(()));
-        assert_eq!(gate.check(&time_msg(10.0), Some(10.01), 0.05), Ok(()), "a resent period");
-        assert_eq!(gate.check(&time_msg(9.99), Some(10.02), 0.05), Err(StampIssue::OutOfOrder));
-        assert_eq!(gate.check(&time_msg(10.2), Some(10.1), 0.05), Err(StampIssue::Future));
-        assert_eq!(gate.check(&time_msg(10.2), None, 0.05), Ok(()), "no clock: only the order");
-        assert_eq!(gate.check(&time_msg(10.1), None, 0.05), Err(StampIssue::OutOfOrder), "the refused stamps did not count, 10.2 did");
+        let pass = |gate: &mut StampGate, t: f64, now: Option<f64>| {
+            let r = gate.check(&time_msg(t), now, 0.05);
+            if r.is_ok() {
+                gate.accept(&time_msg(t));
+            }
+            r
+        };
+        assert_eq!(pass(&mut gate, 10.0, Some(10.0)), Ok(()));
+        assert_eq!(pass(&mut gate, 10.0, Some(10.01)), Ok(()), "a resent period");
+        assert_eq!(pass(&mut gate, 9.99, Some(10.02)), Err(StampIssue::OutOfOrder));
+        assert_eq!(pass(&mut gate, 10.2, Some(10.1)), Err(StampIssue::Future));
+        assert_eq!(pass(&mut gate, 10.11, Some(10.11)), Ok(()), "the refused future stamp holds nothing back");
+        assert_eq!(pass(&mut gate, 10.2, None), Ok(()), "no clock: only the order");
+        assert_eq!(pass(&mut gate, 10.1, None), Err(StampIssue::OutOfOrder), "the refused stamps did not count, 10.2 did");
+        // the clock went back by 5 s: 10.2 is now from the future and blocks no honest message
+        assert_eq!(pass(&mut gate, 5.0, Some(5.0)), Ok(()));
+        assert_eq!(gate.last(), Some(5.0));
+        let unused = StampGate::default();
+        assert_eq!(unused.check(&time_msg(1.0), Some(1.0), 0.0), Ok(()));
+    }
+
+    #[test]
+    fn ages_outside_minus_lead_to_timeout_are_not_fresh() {
+        assert!(fresh(0.0, 0.1, 0.02) && fresh(0.1, 0.1, 0.02) && fresh(-0.02, 0.1, 0.02));
+        assert!(!fresh(0.1001, 0.1, 0.02) && !fresh(-0.021, 0.1, 0.02) && !fresh(f64::NAN, 0.1, 0.02));
     }
 
     #[test]

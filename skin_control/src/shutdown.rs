@@ -1,4 +1,4 @@
-//! A clean stop on SIGINT and SIGTERM: the handler only raises a flag that the spin loop polls,
+//! A clean stop on SIGINT and SIGTERM (or a request from within): the handler only raises a flag that the spin loop polls,
 //! so the node is dropped normally (its DDS entities removed, final messages sent).
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -26,7 +26,12 @@ pub fn install() -> std::io::Result<()> {
     Ok(())
 }
 
-/// Whether SIGINT or SIGTERM has arrived since [`install`].
+/// Asks for the same clean stop from within (a managed node's `shutdown` transition).
+pub fn request() {
+    REQUESTED.store(true, Ordering::SeqCst);
+}
+
+/// Whether SIGINT or SIGTERM has arrived since [`install`], or [`request`] was called.
 pub fn requested() -> bool {
     REQUESTED.load(Ordering::SeqCst)
 }

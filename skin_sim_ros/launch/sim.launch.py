@@ -4,7 +4,8 @@
     ros2 launch skin_sim_ros sim.launch.py scene:=tomm_movable_obstacles rviz:=true
     ros2 launch skin_sim_ros sim.launch.py scene:=tactile_guidance namespace:=tomm
 
-Starts mujoco_sim (real time, or lockstep:=true), task_controller, priority_supervisor,
+Starts mujoco_sim (real time, or lockstep:=true), task_controller, skin_watchdog (not in lockstep),
+priority_supervisor,
 skin_aggregator (all on sim time), robot_state_publisher with the robot's URDF, and RViz on
 request. The robot, its skin layout, the controller setup and whether /scan is an input come from
 the scene (`mujoco_sim --describe`); `setup:=FILE` replaces the scenario's controller setup.
@@ -50,5 +51,7 @@ def generate_launch_description():
         DeclareLaunchArgument("robot_state_publisher", default_value="true",
                               description="start robot_state_publisher (TF of the robot's links)"),
         DeclareLaunchArgument("rviz", default_value="false", description="start RViz with config/skin.rviz"),
+        DeclareLaunchArgument("autostart", default_value="true",
+                              description="activate task_controller at start (as ros2_control's spawner activates controllers)"),
         OpaqueFunction(function=launch_setup),
     ])

@@ -12,7 +12,9 @@ use skin_control::shutdown;
 ///
 /// Runs on a timer at control_rate_hz (ROS time; sim time with use_sim_time:=true), or once per
 /// complete input set with trigger:=inputs (lockstep simulation). Zero commands until every input
-/// has arrived, when inputs go stale, and on SIGINT/SIGTERM.
+/// has arrived, when inputs go stale, and on SIGINT/SIGTERM. Sends /controller/heartbeat with every
+/// period's commands (skin_watchdog zeroes the command topics when it stops); exits with an error
+/// when another task_controller already commands the same topics.
 #[derive(Parser)]
 #[command(
     version,
@@ -35,8 +37,11 @@ fn main() -> Result<()> {
     args.wait.wait(task_controller::NODE, &handle.output_topics(), |t| handle.subscription_count(t))?;
     nodes::spin(&mut node, &mut pool, || {
         handle.poll();
-        Pass::Idle
+        if handle.yielded().is_some() { Pass::Done } else { Pass::Idle }
     });
+    if let Some(why) = handle.yielded() {
+        anyhow::bail!("{why}");
+    }
     handle.stop();
     // Let the zero commands leave before the node goes away.
     node.spin_once(std::time::Duration::from_millis(50));

@@ -5,13 +5,16 @@
 //!
 //! Conventions (docs/ros.md):
 //! - **Joint states** may be partial (TOMM's two arm drivers each publish their own joints on
-//!   `/joint_states`): every message updates the joints it names, the others keep their last
-//!   value. A name that is not a model joint, or a base joint (the base comes from odometry), is
-//!   ignored and counted; a repeated name uses the first occurrence. A non-finite position or
-//!   velocity is not written (the joint keeps its last value) and is counted. A message without
-//!   velocities (allowed by `JointState`) writes positions and counts the missing velocities;
-//!   those joints keep their last velocity (0 until one arrives). The state is complete once
-//!   every arm joint has had a finite position.
+//!   `/joint_states`, each with its own stamps): every message updates the joints it names, the
+//!   others keep their last value. Each joint has its own time: the stamp of the last message
+//!   that wrote it. A joint is written only with a finite position (and a finite velocity when
+//!   the message has one for it) and a stamp not older than the joint's time (the order is kept
+//!   per joint, so two drivers whose stamps differ are both accepted). A name that is not a model
+//!   joint, or a base joint (the base comes from odometry), is ignored and counted; a repeated
+//!   name uses the first occurrence. A joint with a non-finite value is not written (it keeps its
+//!   value and its time, so it ages) and is counted. A message without velocities (allowed by
+//!   `JointState`) writes positions and counts the missing velocities; those joints keep their
+//!   last velocity (0 until one arrives). The state is complete once every joint has a time.
 //! - **Odometry**: pose in the odometry (world) frame, twist in the base frame (`child_frame_id`,
 //!   REP 105); the model's base joints are world x, y, yaw, so the twist is rotated by the yaw.
 //! - **Scan**: ranges outside `[range_min, range_max]` or non-finite are no return; ray `k` is at
@@ -56,17 +59,20 @@ pub enum JointIssue {
     MissingPosition,
     /// `velocity` shorter than `name` (those joints keep their last velocity).
     MissingVelocity,
+    /// A stamp older than the joint's time (a reordered or replayed entry: not written).
+    OutOfOrder,
 }
 
 impl JointIssue {
     /// Every kind, in counter order.
-    pub const ALL: [JointIssue; 6] = [
+    pub const ALL: [JointIssue; 7] = [
         JointIssue::UnknownJoint,
         JointIssue::BaseJoint,
         JointIssue::DuplicateJoint,
         JointIssue::NonFinite,
         JointIssue::MissingPosition,
         JointIssue::MissingVelocity,
+        JointIssue::OutOfOrder,
     ];
 
     /// Short name for logs.
@@ -78,6 +84,7 @@ impl JointIssue {
             JointIssue::NonFinite => "non-finite value",
             JointIssue::MissingPosition => "missing position",
             JointIssue::MissingVelocity => "missing velocity",
+            JointIssue::OutOfOrder => "joint stamp out of order",
         }
     }
 
@@ -87,9 +94,10 @@ impl JointIssue {
             JointIssue::UnknownJoint => "ignored",
             JointIssue::BaseJoint => "ignored, the base comes from odometry",
             JointIssue::DuplicateJoint => "first occurrence used",
-            JointIssue::NonFinite => "not written, last value kept",
+            JointIssue::NonFinite => "joint not written, last value kept (it ages)",
             JointIssue::MissingPosition => "not written, last value kept",
             JointIssue::MissingVelocity => "last velocity kept (0 until one arrives)",
+            JointIssue::OutOfOrder => "older than the joint's last value: not written",
         }
     }
 }
@@ -148,20 +156,18 @@ impl fmt::Display for JointIssueCounts {
 }
 
 /// The measured state in model joint order: arm joints from joint states, base joints from
-/// odometry.
+/// odometry; each joint with the time of its last value.
 #[derive(Debug, Clone)]
 pub struct StateBuffer {
     names: Vec<String>,
     base: Option<[usize; 3]>,
     q: Vec<f64>,
     qd: Vec<f64>,
-    /// Whether each joint has had a finite position (base joints: set by odometry).
-    seen: Vec<bool>,
+    /// Stamp \[s\] of each joint's last value (base joints: of the odometry).
+    time: Vec<Option<f64>>,
     written_by: Vec<u64>,
     messages: u64,
     issues: JointIssueCounts,
-    joint_stamp: Option<Time>,
-    odom_stamp: Option<Time>,
 }
 
 impl StateBuffer {
@@ -174,12 +180,10 @@ impl StateBuffer {
             base,
             q: vec![0.0; n],
             qd: vec![0.0; n],
-            seen: vec![false; n],
+            time: vec![None; n],
             written_by: vec![0; n],
             messages: 0,
             issues: JointIssueCounts::default(),
-            joint_stamp: None,
-            odom_stamp: None,
         }
     }
 
@@ -203,34 +207,37 @@ impl StateBuffer {
         &self.issues
     }
 
-    /// Stamp of the last joint state message.
-    pub fn joint_stamp(&self) -> Option<&Time> {
-        self.joint_stamp.as_ref()
+    /// Oldest and newest time \[s\] of the joints that are not base joints (None: one has none).
+    pub fn joint_times(&self) -> Option<(f64, f64)> {
+        let arm = self.time.iter().enumerate().filter(|(j, _)| !self.base.is_some_and(|b| b.contains(j)));
+        arm.map(|(_, t)| *t).try_fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| t.map(|t| (lo.min(t), hi.max(t))))
     }
 
-    /// Stamp of the last odometry message.
-    pub fn odom_stamp(&self) -> Option<&Time> {
-        self.odom_stamp.as_ref()
+    /// Stamp \[s\] of the last odometry message that was used.
+    pub fn odom_time(&self) -> Option<f64> {
+        self.base.and_then(|b| self.time[b[0]])
     }
 
-    /// Names of the joints that have not had a position yet (empty: the state is complete).
+    /// Names of the joints that have not had a value yet (empty: the state is complete).
     pub fn missing(&self) -> impl Iterator<Item = &str> + '_ {
         self.names
             .iter()
-            .zip(&self.seen)
-            .filter(|(_, s)| !**s)
+            .zip(&self.time)
+            .filter(|(_, t)| t.is_none())
             .map(|(n, _)| n.as_str())
     }
 
     /// Whether every joint (base included) has a measured position.
     pub fn complete(&self) -> bool {
-        self.seen.iter().all(|s| *s)
+        self.time.iter().all(Option::is_some)
     }
 
-    /// Writes the joints named in `msg` (rules in the module doc); `report` gets every issue.
-    pub fn update_joints(&mut self, msg: &JointState, mut report: impl FnMut(&JointStateIssue)) {
+    /// Writes the joints named in `msg` (rules in the module doc); `report` gets every issue. A
+    /// joint time later than `void_after` \[s\] (the clock plus the allowed lead: the clock went
+    /// back) does not hold back older stamps. Returns the number of joints written.
+    pub fn update_joints(&mut self, msg: &JointState, void_after: f64, mut report: impl FnMut(&JointStateIssue)) -> usize {
         self.messages += 1;
-        self.joint_stamp = Some(msg.header.stamp.clone());
+        let t = time_s(&msg.header.stamp);
         let mut note = |issues: &mut JointIssueCounts, kind, index, field, joint: &str| {
             issues.0[kind as usize] += 1;
             report(&JointStateIssue {
@@ -240,6 +247,7 @@ impl StateBuffer {
                 field,
             });
         };
+        let mut written = 0;
         for (i, name) in msg.name.iter().enumerate() {
             let Some(j) = self.names.iter().position(|n| n == name) else {
                 note(&mut self.issues, JointIssue::UnknownJoint, i, "name", name);
@@ -254,24 +262,34 @@ impl StateBuffer {
                 continue;
             }
             self.written_by[j] = self.messages;
-            match msg.position.get(i) {
-                None => note(&mut self.issues, JointIssue::MissingPosition, i, "position", name),
-                Some(p) if !p.is_finite() => {
-                    note(&mut self.issues, JointIssue::NonFinite, i, "position", name)
-                }
-                Some(&p) => {
-                    self.q[j] = p;
-                    self.seen[j] = true;
-                }
+            if self.time[j].is_some_and(|last| t < last && last <= void_after) {
+                note(&mut self.issues, JointIssue::OutOfOrder, i, "header.stamp", name);
+                continue;
             }
+            let p = match msg.position.get(i) {
+                None => {
+                    note(&mut self.issues, JointIssue::MissingPosition, i, "position", name);
+                    continue;
+                }
+                Some(p) if !p.is_finite() => {
+                    note(&mut self.issues, JointIssue::NonFinite, i, "position", name);
+                    continue;
+                }
+                Some(&p) => p,
+            };
             match msg.velocity.get(i) {
                 None => note(&mut self.issues, JointIssue::MissingVelocity, i, "velocity", name),
                 Some(v) if !v.is_finite() => {
-                    note(&mut self.issues, JointIssue::NonFinite, i, "velocity", name)
+                    note(&mut self.issues, JointIssue::NonFinite, i, "velocity", name);
+                    continue;
                 }
                 Some(&v) => self.qd[j] = v,
             }
+            self.q[j] = p;
+            self.time[j] = Some(t);
+            written += 1;
         }
+        written
     }
 
     /// Writes the base joints from odometry. Errors name the field (nothing is written then);
@@ -281,11 +299,11 @@ impl StateBuffer {
             return Ok(());
         };
         let base = odometry_base(msg)?;
-        self.odom_stamp = Some(msg.header.stamp.clone());
+        let t = time_s(&msg.header.stamp);
         for (k, j) in [x, y, yaw].into_iter().enumerate() {
             self.q[j] = base.q[k];
             self.qd[j] = base.qd[k];
-            self.seen[j] = true;
+            self.time[j] = Some(t);
         }
         Ok(())
     }
@@ -499,12 +517,12 @@ mod tests {
             velocity: vec![0.1, 0.0, 0.0, 0.0, 0.2],
             ..Default::default()
         };
-        buf.update_joints(&msg, |i| issues.push(i.clone()));
+        assert_eq!(buf.update_joints(&msg, f64::INFINITY, |i| issues.push(i.clone())), 2);
         let re = model.joint_index("right_elbow_joint").unwrap();
         let le = model.joint_index("left_elbow_joint").unwrap();
         let rw = model.joint_index("right_wrist_1_joint").unwrap();
         assert_eq!((buf.q()[re], buf.qd()[re]), (1.0, 0.1));
-        assert_eq!((buf.q()[le], buf.qd()[le]), (0.0, 0.2), "NaN position not written");
+        assert_eq!((buf.q()[le], buf.qd()[le]), (0.0, 0.0), "NaN position: the joint is not written at all");
         assert_eq!((buf.q()[rw], buf.qd()[rw]), (0.5, 0.0), "missing velocity keeps 0");
         let c = buf.issues();
         for (kind, n) in [(JointIssue::UnknownJoint, 1), (JointIssue::BaseJoint, 1), (JointIssue::DuplicateJoint, 1), (JointIssue::NonFinite, 1), (JointIssue::MissingVelocity, 1)] {
@@ -513,6 +531,45 @@ mod tests {
         assert_eq!(issues[0].to_string(), "name[1] (joint `bogus`): unknown joint (ignored)");
         assert!(!buf.complete());
         assert!(buf.missing().any(|n| n == "base_x_joint"));
+        assert!(buf.missing().any(|n| n == "left_elbow_joint"), "a NaN position gives the joint no time");
+    }
+
+    /// Two arm drivers, each with its own stamps (one lagging): both are written, each joint
+    /// keeps its own time; an older entry, a NaN entry or a message about other joints does not
+    /// refresh a joint.
+    #[test]
+    fn joints_have_their_own_times_and_order() {
+        let model = tomm();
+        let mut buf = StateBuffer::new(&model);
+        let arm = |side: &str, t: f64, v: f64| {
+            let name: Vec<String> = model.joint_names().iter().filter(|n| n.starts_with(side)).cloned().collect();
+            JointState {
+                header: r2r::std_msgs::msg::Header { stamp: time_msg(t), ..Default::default() },
+                position: vec![v; name.len()],
+                velocity: vec![0.0; name.len()],
+                name,
+                ..Default::default()
+            }
+        };
+        let mut none = |_: &JointStateIssue| panic!("no issue");
+        assert_eq!(buf.update_joints(&arm("left_", 10.0, 0.1), f64::INFINITY, &mut none), 6);
+        assert_eq!(buf.update_joints(&arm("right_", 9.98, 0.2), f64::INFINITY, &mut none), 6, "the lagging driver is accepted");
+        assert_eq!(buf.joint_times().unwrap(), (9.98, 10.0));
+        assert_eq!(buf.update_joints(&arm("right_", 9.99, 0.3), f64::INFINITY, &mut none), 6);
+        assert_eq!(buf.update_joints(&arm("left_", 10.01, 0.4), f64::INFINITY, &mut none), 6);
+        assert_eq!(buf.joint_times().unwrap(), (9.99, 10.01));
+        let mut kinds = Vec::new();
+        assert_eq!(buf.update_joints(&arm("left_", 10.0, 9.0), f64::INFINITY, |i| kinds.push(i.kind)), 0, "older than the left joints");
+        assert_eq!(kinds, [JointIssue::OutOfOrder; 6]);
+        let le = model.joint_index("left_elbow_joint").unwrap();
+        assert_eq!(buf.q()[le], 0.4);
+        let mut nan = arm("right_", 10.5, 0.5);
+        nan.velocity[2] = f64::NAN;
+        assert_eq!(buf.update_joints(&nan, f64::INFINITY, |_| {}), 5, "the NaN joint is not refreshed");
+        assert_eq!(buf.joint_times().unwrap(), (9.99, 10.5));
+        // the clock went back below the joints' times: an older stamp is written again
+        assert_eq!(buf.update_joints(&arm("left_", 5.0, 0.6), 9.0, |_| {}), 6);
+        assert_eq!(buf.q()[le], 0.6);
     }
 
     #[test]

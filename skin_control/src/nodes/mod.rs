@@ -45,6 +45,8 @@ pub mod topics {
     pub const ARRANGEMENT: &str = "/supervisor/arrangement";
     /// Phase service (skin_msgs/srv/SetPhase).
     pub const SET_PHASE: &str = "/supervisor/set_phase";
+    /// `skin_watchdog`'s trips (std_msgs/Header: it sent zero commands).
+    pub const WATCHDOG: &str = "/controller/watchdog";
     /// Simulation clock (rosgraph_msgs/Clock): global.
     pub const CLOCK: &str = "/clock";
     /// Transforms (tf2_msgs/TFMessage): global.

@@ -13,16 +13,20 @@ use r2r::geometry_msgs::msg::{PoseStamped, Twist};
 use r2r::nav_msgs::msg::Odometry;
 use r2r::sensor_msgs::msg::{JointState, LaserScan};
 use r2r::skin_msgs::msg::{Arrangement, ControllerState};
-use r2r::std_msgs::msg::{Float64, Float64MultiArray};
+use r2r::std_msgs::msg::{Float64, Float64MultiArray, Header};
 use r2r::{ParameterValue, RosParams};
 use skin_core::controller::ControllerConfig;
 
 use super::topics::*;
 use super::{file_setting, local, resolve, resolved, ros_now, OnceLog, Timing};
 use crate::convert::robot::time_msg;
+use crate::heartbeat::{self, Commander};
+use crate::lifecycle::{self, Lifecycle};
+use r2r::lifecycle_msgs::msg::{State as StateMsg, Transition, Transition as TransitionMsg, TransitionDescription, TransitionEvent};
+use r2r::lifecycle_msgs::srv::{ChangeState, GetAvailableStates, GetAvailableTransitions, GetState};
 use crate::qos;
 use crate::ros_params::StructParams;
-use crate::task_controller::{Idle, InputError, Outputs, TaskController, TaskControllerParams, Trigger, DESCRIPTIONS, START_ONLY};
+use crate::task_controller::{Freshness, Idle, InputError, Outputs, TaskController, TaskControllerParams, Trigger, DESCRIPTIONS, START_ONLY};
 
 /// Node name.
 pub const NODE: &str = "task_controller";
@@ -57,26 +61,183 @@ impl Publishers {
     }
 }
 
+/// Whether this controller may command (one commander per command topic).
+#[derive(Debug, Clone, PartialEq)]
+enum Command {
+    /// At start: listening for another controller's heartbeat until then; nothing is sent.
+    Listening(Instant),
+    /// Sending commands and the heartbeat.
+    Active,
+    /// Another controller commands the same topics: nothing is sent (the reason).
+    Yielded(String),
+}
+
+/// A late period (its gap to the last commands above this many periods) may have tripped
+/// `skin_watchdog`, whose default timeout is 1.5 periods: it sends only the heartbeat, so that the
+/// watchdog's trip notice, if any, is in before the next commands.
+const WATCHDOG_PERIODS: f64 = 1.5;
+
+/// What a timer period sends.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Period {
+    /// Nothing (listening at start) or the heartbeat alone (a late period).
+    Silent,
+    /// Zero commands (holding or taking over from the watchdog).
+    Hold,
+    /// The commands of a cycle when the inputs are fresh.
+    Command,
+}
+
+/// Periods of zero commands (with the heartbeat) when this controller takes over from
+/// `skin_watchdog`'s zeros: the watchdog stops on the first heartbeat, so no zero of its own
+/// falls between the commands that ramp up from zero.
+const TAKE_OVER_PERIODS: u32 = 2;
+
 struct Shared {
     tc: TaskController,
+    lifecycle: Lifecycle,
+    transitions: r2r::Publisher<TransitionEvent>,
     pubs: Publishers,
+    heartbeat: r2r::Publisher<Header>,
+    beat: Header,
+    me: Commander,
+    command: Command,
+    /// ROS time of the last commands sent \[s\].
+    last_sent_s: Option<f64>,
+    /// Periods left of zero commands while taking over ([`TAKE_OVER_PERIODS`]).
+    take_over: u32,
     topics: Vec<String>,
     logger: String,
     clock: Arc<Mutex<r2r::Clock>>,
-    fault_log: OnceLog<1>,
+    fault_log: OnceLog<2>,
     publish_failed: bool,
     stale: bool,
     timing: Timing,
 }
 
 impl Shared {
+    /// Sends the outputs `which` makes, then the heartbeat; nothing unless this controller is the
+    /// commander.
     fn publish(&mut self, which: impl FnOnce(&mut TaskController) -> Outputs<'_>) {
+        if self.command != Command::Active {
+            return;
+        }
+        let now = self.now();
         let out = which(&mut self.tc);
-        if let Err(e) = self.pubs.send(&out, &self.topics) {
+        let sent = self.pubs.send(&out, &self.topics);
+        self.beat.stamp = time_msg(now);
+        let sent = sent.and_then(|()| self.heartbeat.publish(&self.beat).map_err(|e| format!("{}: {e}", heartbeat::TOPIC)));
+        if let Err(e) = sent {
             if !std::mem::replace(&mut self.publish_failed, true) {
                 r2r::log_error!(&self.logger, "publishing failed: {e}");
             }
         }
+        self.last_sent_s = Some(now);
+    }
+
+    /// Timer mode, before a period's commands: the end of the listening window, a late period.
+    fn before_period(&mut self, now: f64) -> Period {
+        if let Command::Listening(until) = self.command {
+            if Instant::now() < until {
+                return Period::Silent;
+            }
+            r2r::log_info!(&self.logger, "no other task_controller heard on {}: commanding", self.topics.join(", "));
+            self.command = Command::Active;
+        }
+        let period = 1.0 / self.tc.params().control_rate_hz;
+        if self.command == Command::Active && self.last_sent_s.is_some_and(|last| now - last > WATCHDOG_PERIODS * period) {
+            self.beat(now);
+            return Period::Silent;
+        }
+        if self.take_over > 0 {
+            self.take_over -= 1;
+            return Period::Hold;
+        }
+        Period::Command
+    }
+
+    /// Sends the heartbeat alone.
+    fn beat(&mut self, now: f64) {
+        self.beat.stamp = time_msg(now);
+        if let Err(e) = self.heartbeat.publish(&self.beat) {
+            if !std::mem::replace(&mut self.publish_failed, true) {
+                r2r::log_error!(&self.logger, "{}: {e}", heartbeat::TOPIC);
+            }
+        }
+        self.last_sent_s = Some(now);
+    }
+
+    /// Zeros went out from someone else: the commands continue from zero after
+    /// [`TAKE_OVER_PERIODS`] zero periods.
+    fn restart_from_zero(&mut self) {
+        self.tc.restart_from_zero();
+        self.take_over = TAKE_OVER_PERIODS;
+    }
+
+    /// A heartbeat on `/controller/heartbeat`: another controller on the same command topics
+    /// that came first makes this one give way.
+    fn on_heartbeat(&mut self, msg: &Header) {
+        let Some(other) = Commander::parse(&msg.frame_id) else { return };
+        if other == self.me || matches!(self.command, Command::Yielded(_)) {
+            return;
+        }
+        if self.me.yields_to(&other) {
+            let shared: Vec<&str> = self.me.shared_topics(&other).collect();
+            let why = format!(
+                "another task_controller (process {}, started earlier) commands {}: this one sends nothing and stops (one commander per robot)",
+                other.process,
+                shared.join(", ")
+            );
+            r2r::log_error!(&self.logger, "{why}");
+            self.command = Command::Yielded(why);
+        } else if self.fault_log.first(1) {
+            r2r::log_warn!(&self.logger, "another task_controller (process {}) heard on the same command topics: it must give way", other.process);
+        }
+    }
+
+    /// A managed-node transition asked by `id` (or `label` when `id` is 0): taken and announced on
+    /// `transition_event`, or refused with the reason in the log. `shutdown` ends the node (zero
+    /// commands first, as on SIGTERM).
+    fn change_state(&mut self, id: u8, label: &str) -> bool {
+        match self.lifecycle.change(id, label) {
+            Ok(t) => {
+                let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos() as u64);
+                let event = TransitionEvent {
+                    timestamp: stamp,
+                    transition: TransitionMsg { id: t.id, label: t.label.into() },
+                    start_state: state_msg(t.from),
+                    goal_state: state_msg(t.to),
+                };
+                if let Err(e) = self.transitions.publish(&event) {
+                    r2r::log_error!(&self.logger, "transition_event: {e}");
+                }
+                let what = match t.to {
+                    lifecycle::State::Active => "commanding",
+                    lifecycle::State::Finalized => "stopping",
+                    _ => "holding: the commands ramp to zero within the acceleration limits",
+                };
+                r2r::log_info!(&self.logger, "lifecycle {}: {} -> {} ({what})", t.label, t.from.label(), t.to.label());
+                if t.to == lifecycle::State::Finalized {
+                    crate::shutdown::request();
+                }
+                true
+            }
+            Err(e) => {
+                r2r::log_warn!(&self.logger, "lifecycle: {e}");
+                false
+            }
+        }
+    }
+
+    /// Whether this period may command motion (the managed node is active).
+    fn active(&self) -> bool {
+        self.lifecycle.state() == lifecycle::State::Active
+    }
+
+    /// `skin_watchdog` sent zeros: continue from zero.
+    fn on_watchdog(&mut self, msg: &Header) {
+        self.restart_from_zero();
+        r2r::log_warn!(&self.logger, "skin_watchdog sent zero commands ({}): continuing from zero", msg.frame_id);
     }
 
     fn run_cycle(&mut self, t_s: f64, stamp: &r2r::builtin_interfaces::msg::Time) {
@@ -104,12 +265,18 @@ impl Shared {
         }
     }
 
-    /// Trigger `inputs`: a cycle when the input set is complete and newer.
+    /// Trigger `inputs`: a cycle when the input set is complete and newer (a holding period
+    /// when the managed node is not active).
     fn maybe_cycle(&mut self) {
         if self.tc.params().trigger == Trigger::Inputs {
             if let Some(stamp) = self.tc.ready_stamp() {
                 let t = crate::convert::robot::time_s(&stamp);
-                self.run_cycle(t, &stamp);
+                if self.active() {
+                    self.run_cycle(t, &stamp);
+                } else {
+                    self.tc.mark_cycle(&stamp);
+                    self.publish(|tc| tc.idle_outputs(Idle::Waiting, &stamp));
+                }
             }
         }
     }
@@ -121,9 +288,13 @@ pub struct TaskControllerHandle {
 }
 
 impl TaskControllerHandle {
-    /// Zero commands on every command topic, then the summary in the log.
+    /// Zero commands on every command topic (unless another controller commands them), then the
+    /// summary in the log.
     pub fn stop(&self) {
         let mut s = self.shared.borrow_mut();
+        if let Command::Listening(_) = s.command {
+            s.command = Command::Active; // nobody else was heard: the zeros are ours to send
+        }
         s.publish(|tc| tc.zero_outputs());
         let (cycles, faults) = s.tc.counts();
         r2r::log_info!(
@@ -163,6 +334,14 @@ impl TaskControllerHandle {
         }
     }
 
+    /// Why this controller gave way to another one on its command topics, if it did.
+    pub fn yielded(&self) -> Option<String> {
+        match &self.shared.borrow().command {
+            Command::Yielded(why) => Some(why.clone()),
+            _ => None,
+        }
+    }
+
     /// The controller's counts (cycles, safe-stop steps).
     pub fn counts(&self) -> (u64, u64) {
         self.shared.borrow().tc.counts()
@@ -185,6 +364,44 @@ fn spawn_sub<M: 'static>(
     Ok(())
 }
 
+/// A `lifecycle_msgs/msg/State`.
+fn state_msg(s: lifecycle::State) -> StateMsg {
+    StateMsg { id: s.id(), label: s.label().into() }
+}
+
+/// The managed-node services under `fqn` (change_state, get_state, get_available_states,
+/// get_available_transitions, get_transition_graph). Each request is a few bytes of work: they
+/// are served in the control loop.
+fn serve_lifecycle(node: &mut r2r::Node, spawner: &LocalSpawner, shared: &Rc<RefCell<Shared>>, fqn: &str) -> Result<()> {
+    let describe = |t: &lifecycle::Transition| TransitionDescription {
+        transition: TransitionMsg { id: t.id, label: t.label.into() },
+        start_state: state_msg(t.from),
+        goal_state: state_msg(t.to),
+    };
+    let change = node.create_service::<ChangeState::Service>(&format!("{fqn}/change_state"), qos::services())?;
+    spawn_sub(spawner, change, shared, |s, req| {
+        let success = s.change_state(req.message.transition.id, &req.message.transition.label);
+        let _ = req.respond(ChangeState::Response { success });
+    })?;
+    let get = node.create_service::<GetState::Service>(&format!("{fqn}/get_state"), qos::services())?;
+    spawn_sub(spawner, get, shared, |s, req| {
+        let _ = req.respond(GetState::Response { current_state: state_msg(s.lifecycle.state()) });
+    })?;
+    let states = node.create_service::<GetAvailableStates::Service>(&format!("{fqn}/get_available_states"), qos::services())?;
+    spawn_sub(spawner, states, shared, |_, req| {
+        let _ = req.respond(GetAvailableStates::Response { available_states: lifecycle::State::ALL.map(state_msg).to_vec() });
+    })?;
+    let available = node.create_service::<GetAvailableTransitions::Service>(&format!("{fqn}/get_available_transitions"), qos::services())?;
+    spawn_sub(spawner, available, shared, move |s, req| {
+        let _ = req.respond(GetAvailableTransitions::Response { available_transitions: s.lifecycle.available().map(describe).collect() });
+    })?;
+    let graph = node.create_service::<GetAvailableTransitions::Service>(&format!("{fqn}/get_transition_graph"), qos::services())?;
+    spawn_sub(spawner, graph, shared, move |_, req| {
+        let _ = req.respond(GetAvailableTransitions::Response { available_transitions: lifecycle::TRANSITIONS.iter().map(describe).collect() });
+    })?;
+    Ok(())
+}
+
 /// Creates the node's parameters, subscriptions, publishers and timer, and spawns its tasks.
 pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> Result<TaskControllerHandle> {
     let logger = node.logger().to_string();
@@ -200,7 +417,6 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     let params = Arc::new(Mutex::new(params));
     let served: Arc<Mutex<dyn RosParams + Send>> = params.clone();
     let (param_services, mut param_changes) = node.make_derived_parameter_handler(served).context("declaring the parameters")?;
-    spawner.spawn_local(param_services)?;
 
     let tc = TaskController::new(config, initial.clone(), ros_now(node)).map_err(|e| anyhow::anyhow!("{setup}: {e}"))?;
     let topics: Vec<String> = tc.arms().iter().map(|a| a.topic.clone()).collect();
@@ -214,6 +430,16 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     if tc.has_base() {
         all_topics.push(resolved(node, local(CMD_VEL)));
     }
+    // Resolved names: the watchdog (in any namespace) zeroes these very topics.
+    let mut described: Vec<String> = tc.arms().iter().map(|a| format!("{}={}", resolved(node, local(&a.topic)), a.joints.len())).collect();
+    described.extend(tc.has_base().then(|| resolved(node, local(CMD_VEL))));
+    let me = Commander::this_process(&described);
+    let beat = Header { stamp: time_msg(0.0), frame_id: me.to_string() };
+    // Timer mode (a robot): listen for another commander first. Lockstep: the simulation's only.
+    let command = match initial.trigger {
+        Trigger::Timer => Command::Listening(Instant::now() + Duration::from_secs_f64(initial.commander_wait_s)),
+        Trigger::Inputs => Command::Active,
+    };
     r2r::log_info!(
         &logger,
         "{setup}: {} joints, {} cells; trigger {:?} at {} Hz, supervisor {:?}; commands on {}",
@@ -224,9 +450,18 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
         initial.supervisor,
         all_topics.join(", ")
     );
+    let fqn = node.fully_qualified_name()?;
     let shared = Rc::new(RefCell::new(Shared {
+        lifecycle: Lifecycle::default(),
+        transitions: node.create_publisher::<TransitionEvent>(&format!("{fqn}/transition_event"), qos::stream())?,
         tc,
         pubs,
+        heartbeat: node.create_publisher::<Header>(local(heartbeat::TOPIC), qos::stream())?,
+        beat,
+        me,
+        command,
+        last_sent_s: None,
+        take_over: TAKE_OVER_PERIODS,
         topics: all_topics,
         logger: logger.clone(),
         clock: node.get_ros_clock(),
@@ -236,13 +471,32 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
         timing: Timing::default(),
     }));
 
+    // Parameter requests are served on a thread of their own: a request of any size (each set
+    // validates the whole struct) must not hold up the control timer. The spin (this thread)
+    // only takes the request; the control timer reads the values with try_lock.
     let log = logger.clone();
-    spawner.spawn_local(async move {
+    let log_changes = async move {
         while let Some((name, value)) = param_changes.next().await {
             r2r::log_info!(&log, "parameter {name} set to {value:?}");
         }
-    })?;
+    };
+    std::thread::Builder::new()
+        .name("task_controller parameters".into())
+        .spawn(move || futures::executor::block_on(futures::future::join(param_services, log_changes)))
+        .context("starting the parameter thread")?;
 
+    serve_lifecycle(node, spawner, &shared, &fqn)?;
+    if initial.autostart {
+        let mut s = shared.borrow_mut();
+        s.change_state(Transition::TRANSITION_CONFIGURE as u8, "");
+        s.change_state(Transition::TRANSITION_ACTIVATE as u8, "");
+    } else {
+        r2r::log_info!(&logger, "holding until activated: ros2 lifecycle set {fqn} configure, then activate (or {fqn}/change_state)");
+    }
+    let beats = node.subscribe::<Header>(local(heartbeat::TOPIC), qos::stream())?;
+    spawn_sub(spawner, beats, &shared, |s, msg| s.on_heartbeat(&msg))?;
+    let trips = node.subscribe::<Header>(local(WATCHDOG), qos::stream())?;
+    spawn_sub(spawner, trips, &shared, |s, msg| s.on_watchdog(&msg))?;
     let js = node.subscribe::<JointState>(local(JOINT_STATES), qos::sensor_input(10))?;
     spawn_sub(spawner, js, &shared, |s, msg| {
         let now = s.now();
@@ -300,27 +554,34 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
             while timer.tick().await.is_ok() {
                 let mut s = shared.borrow_mut();
                 let now = s.now();
-                let (timeout, lead) = {
-                    let p = params.lock().unwrap();
-                    (p.value().input_timeout_s, p.value().max_stamp_lead_s)
-                };
-                s.tc.set_freshness(timeout, lead);
-                match s.tc.input_age(now) {
-                    Some(age) if age <= timeout => {
+                let period = s.before_period(now);
+                if period == Period::Silent {
+                    continue;
+                }
+                let hold = period == Period::Hold || !s.active();
+                // busy serving a request: this period keeps the values it had
+                if let Ok(p) = params.try_lock() {
+                    s.tc.take_settable(p.value());
+                }
+                match s.tc.freshness(now) {
+                    Freshness::Fresh if hold => s.publish(|tc| tc.idle_outputs(Idle::Waiting, &time_msg(now))),
+                    Freshness::Fresh => {
                         if std::mem::replace(&mut s.stale, false) {
                             r2r::log_info!(&s.logger, "inputs fresh again: control resumes");
                         }
                         s.run_cycle(now, &time_msg(now));
                     }
-                    age => {
+                    state => {
                         if !std::mem::replace(&mut s.stale, true) {
-                            let why = match age {
-                                None => format!("waiting for {}", s.tc.missing().join(", ")),
-                                Some(a) => format!("inputs {a:.3} s old (input_timeout_s = {timeout})"),
+                            let why = match state {
+                                Freshness::Stale { input, age_s, timeout_s } => {
+                                    format!("{input} {age_s:.3} s old (allowed: [-max_stamp_lead_s, {timeout_s}] s)")
+                                }
+                                _ => format!("waiting for {}", s.tc.missing().join(", ")),
                             };
                             r2r::log_warn!(&s.logger, "commands ramp to zero: {why}");
                         }
-                        let why = if age.is_none() { Idle::Waiting } else { Idle::Stale };
+                        let why = if state == Freshness::Waiting { Idle::Waiting } else { Idle::Stale };
                         s.publish(|tc| tc.idle_outputs(why, &time_msg(now)));
                     }
                 }

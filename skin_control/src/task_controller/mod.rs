@@ -29,7 +29,7 @@ use crate::convert::control::{
 use crate::convert::robot::{goal_pose, time_s, JointIssue, JointStateIssue, ScanConverter, StateBuffer};
 use crate::convert::cdr_cells::CdrCells;
 use crate::convert::{update_cells, CellBuffer, CellMessage, Issue, IssueKind};
-use crate::input_health::{IssueTable, StampGate, StampIssue};
+use crate::input_health::{fresh, IssueTable, StampGate, StampIssue};
 use crate::nodes::topics::{ARRANGEMENT, CELLS, FORCE_REFERENCE, GOAL, JOINT_STATES, ODOM, SCAN};
 use crate::tf::{ODOM_FRAME, WORLD_FRAME};
 
@@ -97,10 +97,24 @@ pub struct TaskControllerParams {
     pub supervisor: SupervisorSource,
     /// Whether `/scan` is a required input (base avoidance, paper 003 eq. 15-17).
     pub use_scan: bool,
-    /// Timer mode: inputs older than this (ROS time) make the commands ramp to zero \[s\].
+    /// Timer mode: joint states older than this (ROS time; per joint) make the commands ramp to
+    /// zero \[s\].
     pub input_timeout_s: f64,
-    /// Timer mode: a message stamped further ahead of the node's clock than this is refused \[s\].
+    /// Timer mode: the same for odometry \[s\].
+    pub odom_timeout_s: f64,
+    /// Timer mode: the same for the skin cells \[s\].
+    pub cells_timeout_s: f64,
+    /// Timer mode: the same for the scan \[s\] (a LIDAR is slower than a joint driver).
+    pub scan_timeout_s: f64,
+    /// Timer mode: a message stamped further ahead of the node's clock than this is refused, and
+    /// an input whose age is below minus this is stale \[s\].
     pub max_stamp_lead_s: f64,
+    /// Managed node: configure and activate at start (a simulation); false: hold still until
+    /// `change_state` activates it (a robot, as an operator does).
+    pub autostart: bool,
+    /// Timer mode: at start, listen this long for another controller's heartbeat on the same
+    /// command topics before commanding (one commander; DDS discovery takes up to seconds) \[s\].
+    pub commander_wait_s: f64,
     /// Command topics per arm.
     pub arms: ArmsParams,
     /// Skin model (`config/skin_model.yaml`).
@@ -109,9 +123,9 @@ pub struct TaskControllerParams {
     pub tasks: TaskParams,
 }
 
-/// Keys that only the start reads (everything but `input_timeout_s` and `max_stamp_lead_s`): the controller is built
-/// from them once (`skin_core::controller::Controller` has no setter for them at run time).
-pub const START_ONLY: &[&str] = &["control_rate_hz", "trigger", "supervisor", "use_scan", "arms.", "skin.", "tasks."];
+/// Keys that only the start reads (everything but the timeouts and `max_stamp_lead_s`): the
+/// controller is built from them once (`skin_core::controller::Controller` has no setter for them at run time).
+pub const START_ONLY: &[&str] = &["control_rate_hz", "trigger", "supervisor", "use_scan", "autostart", "commander_wait_s", "arms.", "skin.", "tasks."];
 
 /// `ros2 param describe` texts.
 pub const DESCRIPTIONS: &[(&str, &str)] = &[
@@ -119,8 +133,13 @@ pub const DESCRIPTIONS: &[(&str, &str)] = &[
     ("trigger", "timer: cycles on the ROS clock; inputs: one cycle per complete input set with a common stamp (lockstep simulation) (start only)"),
     ("supervisor", "topic: follow /supervisor/arrangement; internal: the controller's own supervisor in the cycle (start only)"),
     ("use_scan", "Whether /scan is a required input (start only)"),
-    ("input_timeout_s", "Timer mode: inputs older than this [s] make the commands ramp to zero within the acceleration limits (settable)"),
-    ("max_stamp_lead_s", "Timer mode: messages stamped more than this [s] ahead of the node's clock are refused (settable)"),
+    ("input_timeout_s", "Timer mode: a joint whose last value is older than this [s] makes the commands ramp to zero within the acceleration limits, in [0.001, 1] (settable)"),
+    ("odom_timeout_s", "Timer mode: odometry older than this [s] makes the commands ramp to zero, in [0.001, 1] (settable)"),
+    ("cells_timeout_s", "Timer mode: skin cells older than this [s] make the commands ramp to zero, in [0.001, 1] (settable)"),
+    ("scan_timeout_s", "Timer mode: a scan older than this [s] makes the commands ramp to zero, in [0.001, 1] (settable)"),
+    ("max_stamp_lead_s", "Timer mode: messages stamped more than this [s] ahead of the node's clock are refused, inputs whose age is below minus this are stale, in [0, 0.1] (settable)"),
+    ("autostart", "Configure and activate the managed node at start; false: hold still (zero commands) until <node>/change_state activates it (start only)"),
+    ("commander_wait_s", "Timer mode: at start, listen this long [s] for another task_controller's heartbeat on the same command topics before commanding; in [0, 10] (start only)"),
     ("arms.namespaces", "Command namespaces, one per arm: <ns>/forward_velocity_controller/commands (start only)"),
     ("arms.joint_prefixes", "Joint-name prefix of each arm's joints, pairs with arms.namespaces (start only)"),
 ];
@@ -137,7 +156,12 @@ impl TaskControllerParams {
             supervisor: SupervisorSource::Topic,
             use_scan: crate::convert::robot::base_joints(&config.model).is_some(),
             input_timeout_s: 0.1,
-            max_stamp_lead_s: 0.1,
+            odom_timeout_s: 0.1,
+            cells_timeout_s: 0.1,
+            scan_timeout_s: 0.25,
+            max_stamp_lead_s: 0.02,
+            autostart: true,
+            commander_wait_s: 3.0,
             arms,
             skin: config.skin,
             tasks: config.tasks.clone(),
@@ -149,9 +173,17 @@ impl TaskControllerParams {
         if !(self.control_rate_hz.is_finite() && self.control_rate_hz > 0.0 && self.control_rate_hz <= 10_000.0) {
             return Err(format!("`control_rate_hz` = {}: must be in (0, 10000]", self.control_rate_hz));
         }
-        for (key, v) in [("input_timeout_s", self.input_timeout_s), ("max_stamp_lead_s", self.max_stamp_lead_s)] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(format!("`{key}` = {v}: must be finite and > 0"));
+        let ranges = [
+            ("input_timeout_s", self.input_timeout_s, TIMEOUT_RANGE),
+            ("odom_timeout_s", self.odom_timeout_s, TIMEOUT_RANGE),
+            ("cells_timeout_s", self.cells_timeout_s, TIMEOUT_RANGE),
+            ("scan_timeout_s", self.scan_timeout_s, TIMEOUT_RANGE),
+            ("max_stamp_lead_s", self.max_stamp_lead_s, LEAD_RANGE),
+            ("commander_wait_s", self.commander_wait_s, (0.0, 10.0)),
+        ];
+        for (key, v, (lo, hi)) in ranges {
+            if !(lo..=hi).contains(&v) {
+                return Err(format!("`{key}` = {v}: must be in [{lo}, {hi}] s"));
             }
         }
         self.skin.validate().map_err(|e| format!("skin.{e}"))?;
@@ -159,6 +191,12 @@ impl TaskControllerParams {
         Ok(())
     }
 }
+
+/// Range of the input timeouts \[s\]: a longer one would let the controller command from a
+/// state a second old.
+pub const TIMEOUT_RANGE: (f64, f64) = (0.001, 1.0);
+/// Range of `max_stamp_lead_s` \[s\].
+pub const LEAD_RANGE: (f64, f64) = (0.0, 0.1);
 
 /// The messages of one cycle.
 pub struct Outputs<'a> {
@@ -188,6 +226,24 @@ impl std::fmt::Display for InputError {
     }
 }
 
+/// The inputs' state at a control period ([`TaskController::freshness`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Freshness {
+    /// Every required input is fresh: a cycle may run.
+    Fresh,
+    /// A required input (a joint) has not arrived yet.
+    Waiting,
+    /// `input`'s age is outside `[-max_stamp_lead_s, timeout_s]`.
+    Stale {
+        /// The topic.
+        input: &'static str,
+        /// Its age \[s\] (the oldest joint's for joint states; negative: stamped ahead of the clock).
+        age_s: f64,
+        /// Its timeout \[s\].
+        timeout_s: f64,
+    },
+}
+
 /// Where the input status of `/controller/state` comes from when no cycle ran.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Idle {
@@ -215,7 +271,8 @@ struct Health {
     /// First counter of the [`JointIssue`] kinds and of the cell [`IssueKind`]s.
     joint_kinds: usize,
     cell_kinds: usize,
-    /// Per timed input: its gate and its first [`StampIssue`] counter.
+    /// Per timed input: its gate and its first [`StampIssue`] counter (joint states: the order is
+    /// kept per joint, the gate checks the clock only).
     stamps: [(StampGate, usize); 4],
     /// The `message refused` counter of each topic that refuses whole messages.
     refused: [(&'static str, usize); 6],
@@ -234,16 +291,28 @@ impl Health {
 
     /// The stamp check of `input` (`now_s`: the clock to compare with, if any).
     fn check_stamp(&mut self, input: Timed, stamp: &Time, now_s: Option<f64>, max_lead_s: f64) -> Result<(), InputError> {
-        let (gate, first) = &mut self.stamps[input as usize];
-        gate.check(stamp, now_s, max_lead_s).map_err(|issue| {
-            let k = *first + issue as usize;
-            let clock = now_s.map_or(String::new(), |n| format!(", clock {n:.6} s"));
-            InputError {
-                topic: TIMED_TOPICS[input as usize],
-                reason: format!("header.stamp {:.6} s: {}{clock}", time_s(stamp), issue.name()),
-                first: self.table.count(k),
-            }
-        })
+        let gate = &self.stamps[input as usize].0;
+        gate.check(stamp, now_s, max_lead_s).map_err(|issue| self.stamp_issue(input, issue, stamp, now_s))
+    }
+
+    /// Counts `issue` of `input`'s message stamped `stamp`.
+    fn stamp_issue(&mut self, input: Timed, issue: StampIssue, stamp: &Time, now_s: Option<f64>) -> InputError {
+        let k = self.stamps[input as usize].1 + issue as usize;
+        let clock = now_s.map_or(String::new(), |n| format!(", clock {n:.6} s"));
+        InputError {
+            topic: TIMED_TOPICS[input as usize],
+            reason: format!("header.stamp {:.6} s: {}{clock}", time_s(stamp), issue.name()),
+            first: self.table.count(k),
+        }
+    }
+
+    /// The last accepted stamp of `input` \[s\].
+    fn last(&self, input: Timed) -> Option<f64> {
+        self.stamps[input as usize].0.last()
+    }
+
+    fn accept(&mut self, input: Timed, stamp: &Time) {
+        self.stamps[input as usize].0.accept(stamp);
     }
 
     /// Counts a refused message of `topic`.
@@ -265,10 +334,10 @@ pub struct TaskController {
     arms: Vec<ArmCommand>,
     needs_odom: bool,
     needs_cells: bool,
-    cells_stamp: Option<Time>,
+    /// The stamp of the last joint state message that wrote a joint.
+    joint_msg_stamp: Option<Time>,
     /// The buffer of [`Self::on_cells_cdr`].
     cdr_cells: CdrCells,
-    scan_stamp: Option<Time>,
     last_cycle: Option<Time>,
     arm_msgs: Vec<Float64MultiArray>,
     twist: Twist,
@@ -308,8 +377,7 @@ impl TaskController {
             no_scan: Vec::new(),
             hand_map,
             arms,
-            cells_stamp: None,
-            scan_stamp: None,
+            joint_msg_stamp: None,
             last_cycle: None,
             cycles: 0,
             faults: 0,
@@ -344,10 +412,18 @@ impl TaskController {
         (self.cycles, self.faults)
     }
 
-    /// Takes the run-time settable keys as the parameter server holds them now.
-    pub fn set_freshness(&mut self, input_timeout_s: f64, max_stamp_lead_s: f64) {
-        self.params.input_timeout_s = input_timeout_s;
-        self.params.max_stamp_lead_s = max_stamp_lead_s;
+    /// Takes the run-time settable keys (the timeouts, `max_stamp_lead_s`) from `p`, the values
+    /// the parameter server holds now.
+    pub fn take_settable(&mut self, p: &TaskControllerParams) {
+        let q = &mut self.params;
+        (q.input_timeout_s, q.odom_timeout_s, q.cells_timeout_s, q.scan_timeout_s) = (p.input_timeout_s, p.odom_timeout_s, p.cells_timeout_s, p.scan_timeout_s);
+        q.max_stamp_lead_s = p.max_stamp_lead_s;
+    }
+
+    /// Zeros were sent on the command topics by someone else (the watchdog): the next command
+    /// continues from zero within the acceleration limits ([`Controller::restart_from_zero`]).
+    pub fn restart_from_zero(&mut self) {
+        self.controller.restart_from_zero();
     }
 
     /// Every input issue counted so far (also in `/controller/state`).
@@ -367,16 +443,30 @@ impl TaskController {
     }
 
     /// `/joint_states` at node time `now_s`; `report` gets the first issue of each kind (all are
-    /// counted).
+    /// counted). Each joint is written only with finite values and a stamp not older than its
+    /// own; a message that writes no joint because of its stamp is refused.
     pub fn on_joint_states(&mut self, msg: &JointState, now_s: f64, mut report: impl FnMut(&JointStateIssue)) -> Result<(), InputError> {
         let lead = self.params.max_stamp_lead_s;
-        self.health.check_stamp(Timed::Joints, &msg.header.stamp, self.clock(now_s), lead)?;
+        let clock = self.clock(now_s);
+        let stamp = &msg.header.stamp;
+        self.health.check_stamp(Timed::Joints, stamp, clock, lead)?;
         let (table, first) = (&mut self.health.table, self.health.joint_kinds);
-        self.state.update_joints(msg, |i| {
+        let mut out_of_order = 0;
+        let written = self.state.update_joints(msg, clock.map_or(f64::INFINITY, |n| n + lead), |i| {
+            out_of_order += usize::from(i.kind == JointIssue::OutOfOrder);
             if table.count(first + i.kind as usize) {
                 report(i);
             }
         });
+        if written > 0 {
+            self.joint_msg_stamp = Some(stamp.clone());
+        }
+        if out_of_order > 0 {
+            let e = self.health.stamp_issue(Timed::Joints, StampIssue::OutOfOrder, stamp, clock);
+            if written == 0 {
+                return Err(e);
+            }
+        }
         Ok(())
     }
 
@@ -384,7 +474,9 @@ impl TaskController {
     pub fn on_odometry(&mut self, msg: &Odometry, now_s: f64) -> Result<(), InputError> {
         let lead = self.params.max_stamp_lead_s;
         self.health.check_stamp(Timed::Odometry, &msg.header.stamp, self.clock(now_s), lead)?;
-        self.state.update_odometry(msg).map_err(self.health.refuse(ODOM))
+        self.state.update_odometry(msg).map_err(self.health.refuse(ODOM))?;
+        self.health.accept(Timed::Odometry, &msg.header.stamp);
+        Ok(())
     }
 
     /// `/skin/cells` at node time `now_s`; `report` gets the first issue of each kind.
@@ -399,7 +491,7 @@ impl TaskController {
             }
         });
         read.map_err(self.health.refuse(CELLS))?;
-        self.cells_stamp = Some(stamp);
+        self.health.accept(Timed::Cells, &stamp);
         Ok(())
     }
 
@@ -419,8 +511,10 @@ impl TaskController {
     pub fn on_scan(&mut self, msg: &LaserScan, now_s: f64) -> Result<(), InputError> {
         let lead = self.params.max_stamp_lead_s;
         self.health.check_stamp(Timed::Scan, &msg.header.stamp, self.clock(now_s), lead)?;
-        self.scan_stamp = Some(msg.header.stamp.clone());
-        self.scan.update(msg).map_err(self.health.refuse(SCAN))
+        // a refused scan leaves no points (nothing seen) and does not refresh the input
+        self.scan.update(msg).map_err(self.health.refuse(SCAN))?;
+        self.health.accept(Timed::Scan, &msg.header.stamp);
+        Ok(())
     }
 
     /// `/goal`: the end-effector goal in the frame `header.frame_id` names: `world` or `odom`
@@ -486,13 +580,13 @@ impl TaskController {
     /// The required inputs that have not arrived yet (empty: complete).
     pub fn missing(&self) -> Vec<String> {
         let mut m: Vec<String> = self.state.missing().filter(|n| !self.is_base_joint(n)).map(|n| format!("joint `{n}`")).collect();
-        if self.needs_odom && self.state.odom_stamp().is_none() {
+        if self.needs_odom && self.state.odom_time().is_none() {
             m.push("odometry".into());
         }
-        if self.needs_cells && self.cells_stamp.is_none() {
+        if self.needs_cells && self.health.last(Timed::Cells).is_none() {
             m.push("skin cells".into());
         }
-        if self.params.use_scan && self.scan_stamp.is_none() {
+        if self.params.use_scan && self.health.last(Timed::Scan).is_none() {
             m.push("scan".into());
         }
         m
@@ -502,36 +596,50 @@ impl TaskController {
         skin_core::resolver::BASE_JOINTS.contains(&name)
     }
 
-    /// The inputs' stamps that must be fresh: joint states, and odometry, cells, scan when required.
-    fn stamps(&self) -> impl Iterator<Item = Option<&Time>> + '_ {
-        [
-            Some(self.state.joint_stamp()),
-            self.needs_odom.then(|| self.state.odom_stamp()),
-            self.needs_cells.then_some(self.cells_stamp.as_ref()),
-            self.params.use_scan.then_some(self.scan_stamp.as_ref()),
-        ]
-        .into_iter()
-        .flatten()
+    /// The required inputs' times \[s\] (joint states: oldest and newest joint) with their topic
+    /// and timeout; None when one has not arrived.
+    fn times(&self) -> Option<impl Iterator<Item = (&'static str, f64, f64)> + '_> {
+        let (lo, hi) = self.state.joint_times()?;
+        let p = &self.params;
+        let required = [
+            Some((JOINT_STATES, Some(lo), p.input_timeout_s)),
+            Some((JOINT_STATES, Some(hi), p.input_timeout_s)),
+            self.needs_odom.then(|| (ODOM, self.state.odom_time(), p.odom_timeout_s)),
+            self.needs_cells.then(|| (CELLS, self.health.last(Timed::Cells), p.cells_timeout_s)),
+            p.use_scan.then(|| (SCAN, self.health.last(Timed::Scan), p.scan_timeout_s)),
+        ];
+        if required.iter().flatten().any(|(_, t, _)| t.is_none()) {
+            return None;
+        }
+        Some(required.into_iter().flatten().map(|(topic, t, timeout)| (topic, t.unwrap_or(f64::NAN), timeout)))
     }
 
     /// Trigger `inputs`: the common stamp of a complete input set that is newer than the last
-    /// cycle, if there is one now.
+    /// cycle, if there is one now (every joint, and every other required input, at one stamp).
     pub fn ready_stamp(&self) -> Option<Time> {
-        if !self.state.complete() {
-            return None;
-        }
-        let first = self.state.joint_stamp()?.clone();
-        let common = self.stamps().all(|s| s == Some(&first));
-        let newer = self.last_cycle.as_ref().is_none_or(|l| time_s(&first) > time_s(l));
-        (common && newer).then_some(first)
+        let stamp = self.joint_msg_stamp.as_ref()?;
+        let t = time_s(stamp);
+        let common = self.times()?.all(|(_, s, _)| s == t);
+        let newer = self.last_cycle.as_ref().is_none_or(|l| t > time_s(l));
+        (common && newer).then(|| stamp.clone())
     }
 
-    /// Trigger `timer`: the age of the oldest required input at `now_s` (None: one is missing).
-    pub fn input_age(&self, now_s: f64) -> Option<f64> {
-        if !self.state.complete() {
-            return None;
+    /// Trigger `timer`: whether every required input is fresh at `now_s`: each input's age
+    /// (every joint's, for joint states) within `[-max_stamp_lead_s, its timeout]`.
+    pub fn freshness(&self, now_s: f64) -> Freshness {
+        let Some(mut times) = self.times() else {
+            return Freshness::Waiting;
+        };
+        let lead = self.params.max_stamp_lead_s;
+        match times.find(|&(_, t, timeout)| !fresh(now_s - t, timeout, lead)) {
+            None => Freshness::Fresh,
+            Some((input, t, timeout_s)) => Freshness::Stale { input, age_s: now_s - t, timeout_s },
         }
-        self.stamps().map(|s| s.map(|t| now_s - time_s(t))).try_fold(0.0f64, |a, age| age.map(|x| a.max(x)))
+    }
+
+    /// Trigger `inputs`: takes `stamp` as the last cycle's without a cycle (a holding period).
+    pub fn mark_cycle(&mut self, stamp: &Time) {
+        self.last_cycle = Some(stamp.clone());
     }
 
     /// Zero commands on every output, no controller state: the last messages at shutdown.

@@ -2,7 +2,7 @@
 //! acceleration limits and control resumes without a jump; stamps out of order or from the future
 //! are refused; every bad input is counted in `/controller/state`.
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
-use r2r::sensor_msgs::msg::JointState;
+use r2r::sensor_msgs::msg::{JointState, LaserScan};
 use r2r::skin_msgs::msg::{ControllerState, SkinCellArray};
 use skin_core::controller::ControllerConfig;
 
@@ -51,15 +51,16 @@ fn command(out: &Outputs) -> Vec<f64> {
     out.arms.iter().flat_map(|m| m.data.iter().copied()).collect()
 }
 
-/// Runs `n` fresh periods from `t`, the robot moving at `v0` first, then following its commands
-/// exactly; returns the last command and the time after.
+/// Runs `n` fresh periods from `t`, the robot moving at `v0` first (NaN: the last commands),
+/// then following its commands exactly; returns the last command and the time after.
 fn run_fresh(tc: &mut TaskController, mut t: f64, q: &mut [f64], v0: f64, n: usize) -> (Vec<f64>, f64) {
     let dt = 1.0 / RATE_HZ;
-    let mut v = vec![v0; q.len()];
+    let last: Vec<f64> = tc.controller().output().commands.joint_velocities.clone();
+    let mut v = if v0.is_nan() { last } else { vec![v0; q.len()] };
     for _ in 0..n {
         tc.on_joint_states(&joint_state(tc, t, q, &v), t, |_| {}).unwrap();
         tc.on_cells(&cells(t, &[]), t, |_| {}).unwrap();
-        assert!(tc.input_age(t).unwrap().abs() < 1e-9);
+        assert_eq!(tc.freshness(t), Freshness::Fresh);
         let out = tc.cycle(t, &time_msg(t));
         assert_eq!(out.state.unwrap().input_status, ControllerState::INPUT_FRESH as u8);
         v = command(&out);
@@ -75,11 +76,21 @@ fn run_fresh(tc: &mut TaskController, mut t: f64, q: &mut [f64], v0: f64, n: usi
 fn stale_inputs_ramp_the_commands_down_and_control_resumes_without_a_jump() {
     let mut tc = controller();
     let mut q = vec![1.4, -0.5, -0.5, -0.4, -0.3, -0.2, 0.1];
-    // the controller starts from the measured motion: commands near 0.8 rad/s
-    let (moving, t) = run_fresh(&mut tc, 0.0, &mut q, 0.8, 2);
-    let peak = moving.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    assert!(peak > 0.5, "the arm moves: {moving:?}");
     let step = AMAX / RATE_HZ * (1.0 + 1e-9);
+    // a wrong measured velocity (0.8 rad/s) at start: the first command starts from zero
+    let (first, t) = run_fresh(&mut tc, 0.0, &mut q, 0.8, 1);
+    assert!(first.iter().all(|v| v.abs() <= step), "{first:?}");
+    // on towards the goal until a joint moves faster than one step
+    let (mut moving, mut t) = (first, t);
+    let peak_of = |v: &[f64]| v.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    for _ in 0..50 {
+        (moving, t) = run_fresh(&mut tc, t, &mut q, f64::NAN, 1);
+        if peak_of(&moving) > 1.5 * step {
+            break;
+        }
+    }
+    let peak = peak_of(&moving);
+    assert!(peak > 1.5 * step, "the arm moves: {moving:?}");
 
     // inputs stop: every period decelerates by at most a_max dt, down to exactly zero
     let mut last = moving.clone();
@@ -125,15 +136,18 @@ fn stamps_out_of_order_or_from_the_future_are_refused_and_counted() {
     assert!(e.reason.contains("stamp out of order"), "{e}");
     assert_eq!(tc.state.q()[0], 1.4, "the refused message wrote nothing");
     assert!(!tc.on_joint_states(&old, 10.01, |_| {}).unwrap_err().first, "logged once, counted always");
-    let future = cells(10.5, &[]);
+    let future = cells(10.1, &[]);
     let e = tc.on_cells(&future, 10.02, |_| {}).unwrap_err();
-    assert!(e.to_string().starts_with("/skin/cells: header.stamp 10.500000 s: stamp in the future"), "{e}");
-    tc.set_freshness(0.1, 1.0);
+    assert!(e.to_string().starts_with("/skin/cells: header.stamp 10.100000 s: stamp in the future"), "{e}");
+    let mut p = tc.params().clone();
+    p.max_stamp_lead_s = 0.1;
+    tc.take_settable(&p);
     tc.on_cells(&future, 10.02, |_| {}).unwrap();
     let issues = tc.issues();
     assert_eq!(issues.by_name("/joint_states: stamp out of order"), Some(2));
     assert_eq!(issues.by_name("/skin/cells: stamp in the future"), Some(1));
-    assert_eq!(issues.total(), 3);
+    assert_eq!(issues.by_name("/joint_states: joint stamp out of order"), Some(14), "per joint entry");
+    assert_eq!(issues.total(), 17);
 }
 
 #[test]
@@ -172,4 +186,188 @@ fn every_bad_input_is_counted_in_the_controller_state() {
     assert_eq!(count("/hand_force_reference: message refused"), Some(1));
     assert_eq!(state.issue_counts.iter().sum::<u64>(), 10);
     assert_eq!(state.safe_stop_cycles, 0);
+}
+
+/// `/joint_states` messages of planar7's joints `range` stamped `t`, at `q` (velocity 0).
+fn some_joints(tc: &TaskController, t: f64, range: std::ops::Range<usize>, q: &[f64]) -> JointState {
+    let mut js = joint_state(tc, t, q, &[0.0; 7]);
+    js.name = js.name[range.clone()].to_vec();
+    js.position = js.position[range.clone()].to_vec();
+    js.velocity = js.velocity[range].to_vec();
+    js
+}
+
+/// Joint health is per joint: a message that writes no joint (other joints only, unknown names,
+/// NaN values) refreshes nothing, so one silent driver or one NaN encoder makes the state stale.
+#[test]
+fn every_joint_must_be_fresh_and_finite() {
+    let q = [1.4, -0.5, -0.5, -0.4, -0.3, -0.2, 0.1];
+    let start = |tc: &mut TaskController| {
+        tc.on_joint_states(&joint_state(tc, 1.0, &q, &[0.0; 7]), 1.0, |_| {}).unwrap();
+    };
+    let stale_joint = |f: Freshness| matches!(f, Freshness::Stale { input: "/joint_states", .. });
+    // one driver (joints 0-3) goes silent while the other (4-6) and the skin go on
+    let mut tc = controller();
+    start(&mut tc);
+    for k in 1..=20 {
+        let t = 1.0 + 0.01 * k as f64;
+        tc.on_joint_states(&some_joints(&tc, t, 4..7, &q), t, |_| {}).unwrap();
+        tc.on_cells(&cells(t, &[]), t, |_| {}).unwrap();
+        if k == 9 {
+            assert_eq!(tc.freshness(t), Freshness::Fresh, "joints 0-3 are 0.09 s old: within the timeout");
+        }
+    }
+    let f = tc.freshness(1.2);
+    assert!(stale_joint(f), "joints 0-3 are 0.2 s old: {f:?}");
+    // a NaN position or velocity on one joint, unknown names, a base joint: that joint ages
+    for bad in 0..4 {
+        let mut tc = controller();
+        start(&mut tc);
+        for k in 1..=20 {
+            let t = 1.0 + 0.01 * k as f64;
+            let mut js = joint_state(&tc, t, &q, &[0.0; 7]);
+            match bad {
+                0 => js.position[3] = f64::NAN,
+                1 => js.velocity[3] = f64::INFINITY,
+                2 => js.name[3] = "gripper_joint".into(),
+                _ => js.name[3] = "base_x_joint".into(),
+            }
+            tc.on_joint_states(&js, t, |_| {}).unwrap();
+            tc.on_cells(&cells(t, &[]), t, |_| {}).unwrap();
+        }
+        assert!(stale_joint(tc.freshness(1.2)), "case {bad}: {:?}", tc.freshness(1.2));
+        assert_eq!(tc.state.q()[3], q[3], "case {bad}: the last good value is kept, not overwritten");
+    }
+    // a message with only other joints' names (or none) is no news about joint 3
+    let mut tc = controller();
+    start(&mut tc);
+    let mut empty = joint_state(&tc, 1.15, &q, &[0.0; 7]);
+    (empty.name, empty.position, empty.velocity) = (vec!["gripper_joint".into()], vec![0.0], vec![0.0]);
+    tc.on_joint_states(&empty, 1.15, |_| {}).unwrap();
+    tc.on_cells(&cells(1.15, &[]), 1.15, |_| {}).unwrap();
+    assert!(stale_joint(tc.freshness(1.2)));
+}
+
+/// Two drivers on `/joint_states`, each with its own stamps, one lagging the other by 20 ms:
+/// every message of both is accepted (the order is kept per joint), the state stays fresh and
+/// the lagging joints follow their driver.
+#[test]
+fn two_drivers_with_their_own_stamps_are_both_accepted() {
+    let mut tc = controller();
+    let mut q = [1.4, -0.5, -0.5, -0.4, -0.3, -0.2, 0.1];
+    for k in 0..50 {
+        let t = 1.0 + 0.008 * k as f64;
+        q[6] = 0.1 + 0.001 * k as f64;
+        tc.on_joint_states(&some_joints(&tc, t, 0..4, &q), t, |_| {}).unwrap();
+        tc.on_joint_states(&some_joints(&tc, t - 0.02, 4..7, &q), t, |_| panic!("an issue with the lagging driver")).unwrap();
+        tc.on_cells(&cells(t, &[]), t, |_| {}).unwrap();
+        assert_eq!(tc.freshness(t), Freshness::Fresh);
+        assert_eq!(tc.state.q()[6], q[6], "the lagging driver's joint is written");
+    }
+    assert_eq!(tc.issues().total(), 0, "{}", tc.issues());
+    // a replayed old message of one driver is refused (and counted), the other is unaffected
+    let e = tc.on_joint_states(&some_joints(&tc, 1.0, 4..7, &[0.0; 7]), 1.4, |_| {}).unwrap_err();
+    assert!(e.reason.contains("stamp out of order"), "{e}");
+    assert_eq!(tc.state.q()[6], q[6]);
+}
+
+/// Honest time: a stamp ahead of the clock beyond `max_stamp_lead_s` is refused and counted and
+/// holds no later honest message back; an input whose age is below `-max_stamp_lead_s` (the
+/// clock went back) is stale, and honest messages on the new clock are taken again.
+#[test]
+fn stamps_from_the_future_are_refused_and_negative_ages_are_stale() {
+    let mut tc = controller();
+    let q = [1.4, -0.5, -0.5, -0.4, -0.3, -0.2, 0.1];
+    let feed = |tc: &mut TaskController, stamp: f64, now: f64| {
+        let js = tc.on_joint_states(&joint_state(tc, stamp, &q, &[0.0; 7]), now, |_| {});
+        let c = tc.on_cells(&cells(stamp, &[]), now, |_| {});
+        js.and(c)
+    };
+    feed(&mut tc, 10.0, 10.0).unwrap();
+    let e = feed(&mut tc, 10.095, 10.0).unwrap_err();
+    assert!(e.reason.contains("stamp in the future"), "{e}");
+    feed(&mut tc, 10.008, 10.008).unwrap();
+    assert_eq!(tc.freshness(10.01), Freshness::Fresh);
+    assert_eq!(tc.issues().by_name("/joint_states: stamp in the future"), Some(1));
+    // the clock steps back by 2 s: every input is from the future, so stale (not fresh for 2 s)
+    let f = tc.freshness(8.01);
+    assert!(matches!(f, Freshness::Stale { age_s, .. } if age_s < -1.9), "{f:?}");
+    // honest messages on the new clock are accepted at once, and control may resume
+    feed(&mut tc, 8.02, 8.02).unwrap();
+    assert_eq!(tc.freshness(8.02), Freshness::Fresh);
+}
+
+/// Per-input timeouts and their ranges.
+#[test]
+fn timeouts_are_per_input_and_bounded() {
+    let config = ControllerConfig::load(&paths::resolve("config/controller/planar7.yaml").unwrap()).unwrap();
+    let mut p = TaskControllerParams::defaults(&config);
+    p.validate().unwrap();
+    for key in ["input_timeout_s", "odom_timeout_s", "cells_timeout_s", "scan_timeout_s", "max_stamp_lead_s"] {
+        for v in [1e300, -1.0, f64::NAN, 2.0] {
+            let mut bad = p.clone();
+            match key {
+                "input_timeout_s" => bad.input_timeout_s = v,
+                "odom_timeout_s" => bad.odom_timeout_s = v,
+                "cells_timeout_s" => bad.cells_timeout_s = v,
+                "scan_timeout_s" => bad.scan_timeout_s = v,
+                _ => bad.max_stamp_lead_s = v,
+            }
+            let e = bad.validate().unwrap_err();
+            assert!(e.contains(key) && e.contains("must be in ["), "{e}");
+        }
+    }
+    // the skin cells have their own timeout: cells 0.15 s old are stale at 0.1, fresh at 0.2
+    let mut tc = controller();
+    let q = [1.4, -0.5, -0.5, -0.4, -0.3, -0.2, 0.1];
+    tc.on_cells(&cells(1.0, &[]), 1.0, |_| {}).unwrap();
+    tc.on_joint_states(&joint_state(&tc, 1.15, &q, &[0.0; 7]), 1.15, |_| {}).unwrap();
+    assert!(matches!(tc.freshness(1.15), Freshness::Stale { input: "/skin/cells", .. }));
+    p.cells_timeout_s = 0.2;
+    tc.take_settable(&p);
+    assert_eq!(tc.freshness(1.15), Freshness::Fresh);
+}
+
+/// TOMM (a base with a LIDAR): a refused scan (a frame not on the base) does not refresh the
+/// scan input: the state goes stale once the last good scan is older than `scan_timeout_s`.
+#[test]
+fn a_refused_scan_does_not_refresh_the_scan() {
+    let config = ControllerConfig::load(&paths::resolve("config/controller/tomm.yaml").unwrap()).unwrap();
+    let params = TaskControllerParams::defaults(&config);
+    let mut tc = TaskController::new(config, params, 0.0).unwrap();
+    let names = tc.controller().config().model.joint_names().to_vec();
+    let arm: Vec<String> = names.iter().filter(|n| !n.starts_with("base_")).cloned().collect();
+    let scan = |t: f64, frame: &str| LaserScan {
+        header: r2r::std_msgs::msg::Header { stamp: time_msg(t), frame_id: frame.into() },
+        angle_increment: 0.1,
+        range_max: 5.0,
+        ranges: vec![1.0; 10],
+        ..Default::default()
+    };
+    let mut odom = r2r::nav_msgs::msg::Odometry::default();
+    odom.pose.pose.orientation.w = 1.0;
+    let mut feed = |tc: &mut TaskController, t: f64, frame: &str| {
+        let js = JointState {
+            header: r2r::std_msgs::msg::Header { stamp: time_msg(t), ..Default::default() },
+            position: vec![0.0; arm.len()],
+            velocity: vec![0.0; arm.len()],
+            name: arm.clone(),
+            ..Default::default()
+        };
+        tc.on_joint_states(&js, t, |_| {}).unwrap();
+        odom.header.stamp = time_msg(t);
+        tc.on_odometry(&odom, t).unwrap();
+        tc.on_cells(&cells(t, &[]), t, |_| {}).unwrap();
+        tc.on_scan(&scan(t, frame), t)
+    };
+    let e = feed(&mut tc, 1.0, "right_hand").unwrap_err();
+    assert!(e.reason.contains("`right_hand`"), "{e}");
+    assert_eq!(tc.freshness(1.0), Freshness::Waiting, "a refused scan is no scan: {:?}", tc.missing());
+    feed(&mut tc, 1.01, "laser").unwrap();
+    assert_eq!(tc.freshness(1.01), Freshness::Fresh);
+    for k in 2..40 {
+        assert!(feed(&mut tc, 1.0 + 0.01 * k as f64, "right_hand").is_err());
+    }
+    let f = tc.freshness(1.39);
+    assert!(matches!(f, Freshness::Stale { input: "/scan", .. }), "{f:?}");
 }

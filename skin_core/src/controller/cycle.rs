@@ -36,8 +36,10 @@ fn stage<E>(name: &'static str) -> impl FnOnce(E) -> Fault {
 ///
 /// Bad input (wrong lengths, NaN state, bad `dt`) or a failed stage makes the cycle a safe-stop
 /// step instead (`ControllerOutput::fault`), so the commands are always finite and within the
-/// limits. The first valid measured state resets the resolver (commands continue from the
-/// measured motion); before it the commands are zero. After [`Controller::new`] nothing allocates (`tests/no_alloc.rs`).
+/// limits. Commands start at zero and every command continues from the last one within the
+/// acceleration limits, from the first cycle on: a measured velocity never sets a command (one
+/// wrong reading at start must not become a velocity step). After [`Controller::new`] nothing
+/// allocates (`tests/no_alloc.rs`).
 #[derive(Debug, Clone)]
 pub struct Controller {
     config: ControllerConfig,
@@ -69,7 +71,7 @@ pub struct Controller {
     /// [`HierarchyDynamics::Admittance`]: the resolver's virtual inertia and bias `g + C_a v`.
     mass: DMatrix<f64>,
     bias: DVector<f64>,
-    /// The resolver has been reset from a valid measured state.
+    /// A cycle has run on a valid measured state (the position hold captures its pose then).
     started: bool,
     output: ControllerOutput,
 }
@@ -279,6 +281,15 @@ impl Controller {
         self.resolver.safe_stop(dt_s)
     }
 
+    /// Zero commands were sent to the robot by someone else (a watchdog, while this controller
+    /// was late or its link was down): the next command continues from zero within the
+    /// acceleration limits, not from this controller's last one.
+    pub fn restart_from_zero(&mut self) {
+        self.resolver.restart_from_zero();
+        self.output.commands.joint_velocities.fill(0.0);
+        self.output.commands.base_twist = [0.0; 3];
+    }
+
     /// Lengths and finiteness of the measured state.
     fn check_state(&self, input: &ControllerInput) -> Result<(), Fault> {
         let nv = self.config.model.nv();
@@ -307,13 +318,8 @@ impl Controller {
 
     fn run(&mut self, input: &ControllerInput) -> Result<(), Fault> {
         self.check_state(input)?;
-        let first = !self.started;
-        if first {
-            // start from the measured motion (a safe stop then ramps down from it, no jump)
-            self.resolver.reset(input.q, input.qd).map_err(stage("resolver reset"))?;
-            self.started = true;
-        }
         self.check_rest(input)?;
+        let first = !std::mem::replace(&mut self.started, true);
         self.live.collect(input.cells);
         update_kinematics(&self.config.model, &mut self.data, input.q, input.qd).map_err(stage("kinematics"))?;
 

@@ -224,3 +224,28 @@ fn hand_moment_is_the_palm_patch_moment_in_the_hand_frame() {
     let out = c.update(&ControllerInput { t_s: 0.008, dt_s: 0.008, q: &q, qd: &vec![0.0; nv], cells: &cells, scan: &[] });
     assert_eq!(out.hand_moment, Vector3::zeros(), "no touch, no moment");
 }
+
+/// One wrong velocity reading at start (every joint at its limit, the base at 0.5 m/s) must not
+/// become the first command: commands start from zero, the last command sent, within the
+/// acceleration limits.
+#[test]
+fn the_first_command_starts_from_zero_whatever_the_measured_velocity() {
+    let mut c = controller("tomm");
+    let nv = c.config().model.nv();
+    let q = c.config().setup.posture.clone();
+    let mut qd = vec![std::f64::consts::FRAC_PI_2; nv];
+    let [bx, by, _] = c.resolver().base_joints().unwrap();
+    (qd[bx], qd[by]) = (0.5, 0.0);
+    let cells = vec![CellReading::default(); c.config().layout.num_cells()];
+    let dt = 0.008;
+    let out = c.update(&ControllerInput { t_s: 0.0, dt_s: dt, q: &q, qd: &qd, cells: &cells, scan: &[] }).clone();
+    assert_eq!(out.fault, None);
+    let amax: Vec<f64> = c.resolver().arm_acceleration_limits().collect();
+    for (v, a) in out.commands.joint_velocities.iter().zip(&amax) {
+        assert!(v.abs() <= a * dt * (1.0 + 1e-12), "{v} from a measured {}", qd[0]);
+    }
+    let b = &c.config().resolver.base;
+    let [vx, vy, wz] = out.commands.base_twist;
+    assert!(vx.hypot(vy) <= b.max_linear_accel_m_s2 * dt * (1.0 + 1e-12), "{vx} {vy}");
+    assert!(wz.abs() <= b.max_angular_accel_rad_s2 * dt * (1.0 + 1e-12));
+}

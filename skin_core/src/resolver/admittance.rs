@@ -90,8 +90,8 @@ pub struct Resolver {
     base: Option<[usize; 3]>,
     base_steps: [Step; 3],
     base_dt: f64,
-    /// Base virtual velocity = last command, WORLD frame (x, y, yaw rate).
-    base_world: [f64; 3],
+    /// The last commands; the base's virtual velocity is its last twist, in the BASE frame (the
+    /// frame it is sent in, where its rate limit holds whatever the measured yaw does).
     commands: Commands,
 }
 
@@ -149,7 +149,6 @@ impl Resolver {
             base,
             base_steps: [Step::default(); 3],
             base_dt: f64::NAN,
-            base_world: [0.0; 3],
             commands: Commands {
                 joint_velocities: vec![0.0; na],
                 base_twist: [0.0; 3],
@@ -249,10 +248,16 @@ impl Resolver {
             *v = qd_measured[a.index];
         }
         if let Some(b) = self.base {
-            self.base_world = b.map(|j| qd_measured[j]);
-            self.commands.base_twist = to_base_frame(self.base_world, q_measured[b[2]]);
+            self.commands.base_twist = to_base_frame(b.map(|j| qd_measured[j]), q_measured[b[2]]);
         }
         Ok(())
+    }
+
+    /// Takes zero as the last command of every joint and of the base: zeros were sent by someone
+    /// else (a watchdog), so the next step continues from zero within the acceleration limits.
+    pub fn restart_from_zero(&mut self) {
+        self.commands.joint_velocities.fill(0.0);
+        self.commands.base_twist = [0.0; 3];
     }
 
     /// One step of the arms (all vectors in model order, length = number of model joints):
@@ -343,29 +348,27 @@ impl Resolver {
         }
         let sync = -(-p.sync_gain_per_s * dt).exp_m1();
         let yaw = q_measured[iyaw];
-        let prev = self.base_world;
-        let measured = [qd_measured[ix], qd_measured[iy], qd_measured[iyaw]];
+        // eq. (26) lower row in the base frame, where M_b and D_b are constant and the command is
+        // sent: the virtual velocity is the last command, pulled towards the measured one
+        let prev = self.commands.base_twist;
+        let measured = to_base_frame([qd_measured[ix], qd_measured[iy], qd_measured[iyaw]], yaw);
         let v: [f64; 3] = core::array::from_fn(|k| prev[k] + sync * (measured[k] - prev[k]));
-        // eq. (26) lower row in the base frame, where M_b and D_b are constant
-        let vb = to_base_frame(v, yaw);
         let fb = to_base_frame([tau[ix], tau[iy], tau[iyaw]], yaw);
         let s = &self.base_steps;
         let vb: [f64; 3] =
-            core::array::from_fn(|k| finite_or_max(s[k].e * vb[k] + s[k].phi * fb[k]));
-        // limits (norms are frame independent); the rate limit acts on the world-frame velocity,
-        // the base's physical acceleration
+            core::array::from_fn(|k| finite_or_max(s[k].e * v[k] + s[k].phi * fb[k]));
+        // limits: velocity, then the rate limit against the last command in the base frame (a
+        // jump of the measured yaw, an odometry reset, cannot turn the command)
         let lin = clamp_norm([vb[0], vb[1]], p.max_linear_m_s);
         let w = vb[2].clamp(-p.max_angular_rad_s, p.max_angular_rad_s);
-        let target = to_world_frame([lin[0], lin[1], w], yaw);
         let step = clamp_norm(
-            [target[0] - prev[0], target[1] - prev[1]],
+            [lin[0] - prev[0], lin[1] - prev[1]],
             p.max_linear_accel_m_s2 * dt,
         );
         let lin = clamp_norm([prev[0] + step[0], prev[1] + step[1]], p.max_linear_m_s);
-        let w = rate_limit(prev[2], target[2], p.max_angular_accel_rad_s2 * dt)
+        let w = rate_limit(prev[2], w, p.max_angular_accel_rad_s2 * dt)
             .clamp(-p.max_angular_rad_s, p.max_angular_rad_s);
-        self.base_world = [lin[0], lin[1], w];
-        self.commands.base_twist = to_base_frame(self.base_world, yaw);
+        self.commands.base_twist = [lin[0], lin[1], w];
         Ok(&self.commands)
     }
 
@@ -397,7 +400,8 @@ impl Resolver {
         let Some(b) = self.base else { return };
         let p = &self.params.base;
         let s = sync(p.sync_gain_per_s);
-        let v: [f64; 3] = core::array::from_fn(|k| self.base_world[k] + s * (qd_measured[b[k]] - self.base_world[k]));
+        let last = to_world_frame(self.commands.base_twist, q_measured[b[2]]);
+        let v: [f64; 3] = core::array::from_fn(|k| last[k] + s * (qd_measured[b[k]] - last[k]));
         let (sn, c) = q_measured[b[2]].sin_cos();
         let rot = nalgebra::Matrix2::new(c, -sn, sn, c);
         let m = rot * nalgebra::Matrix2::from_diagonal(&nalgebra::Vector2::new(p.inertia[0], p.inertia[1])) * rot.transpose();
@@ -449,20 +453,15 @@ impl Resolver {
     }
 
     /// One step of the safe stop of the base: the planar velocity decelerates along its direction
-    /// and the yaw rate towards zero, within the base's acceleration limits. The twist is
-    /// expressed with the yaw of the last valid update.
+    /// and the yaw rate towards zero, within the base's acceleration limits (in the base frame,
+    /// where the twist is sent).
     pub fn safe_stop_base(&mut self, dt_s: f64) -> &Commands {
         let p = &self.params.base;
         let dt = self.safe_dt(dt_s, p.rate_hz);
-        let v = self.base_world;
-        let step = clamp_norm([-v[0], -v[1]], p.max_linear_accel_m_s2 * dt);
-        let w = rate_limit(v[2], 0.0, p.max_angular_accel_rad_s2 * dt);
-        // the twist's base-frame direction is unchanged by a common scaling
-        let (old, new) = (v[0].hypot(v[1]), (v[0] + step[0]).hypot(v[1] + step[1]));
-        let s = if old > 0.0 { new / old } else { 0.0 };
         let t = self.commands.base_twist;
-        self.base_world = [v[0] + step[0], v[1] + step[1], w];
-        self.commands.base_twist = [t[0] * s, t[1] * s, w];
+        let step = clamp_norm([-t[0], -t[1]], p.max_linear_accel_m_s2 * dt);
+        let w = rate_limit(t[2], 0.0, p.max_angular_accel_rad_s2 * dt);
+        self.commands.base_twist = [t[0] + step[0], t[1] + step[1], w];
         &self.commands
     }
 

@@ -256,6 +256,43 @@ fn resolver_base_twist_is_in_the_base_frame() {
     assert!(t[0].abs() < 1e-12 && t[1] < -0.05 && t[2] == 0.0, "{t:?}");
 }
 
+/// An odometry reset or a localisation correction turns the measured yaw by 90 degrees in one
+/// message: the twist, sent in the base frame, changes within the acceleration limits (the rate
+/// limit holds in the frame of the command, not in the world frame).
+#[test]
+fn resolver_base_rate_limit_holds_in_the_base_frame_across_a_yaw_jump() {
+    let m = model("tomm");
+    let n = m.nv();
+    let p = ResolverParams::default();
+    let mut r = Resolver::new(&m, p.clone()).unwrap();
+    let mut q = vec![0.0; n];
+    let mut qd = vec![0.0; n];
+    let mut tau = vec![0.0; n];
+    let mut prev = r.commands().base_twist;
+    let step_ok = |a: [f64; 3], b: [f64; 3]| {
+        (a[0] - b[0]).hypot(a[1] - b[1]) <= p.base.max_linear_accel_m_s2 * BASE_DT * (1.0 + 1e-12)
+            && (a[2] - b[2]).abs() <= p.base.max_angular_accel_rad_s2 * BASE_DT * (1.0 + 1e-12)
+    };
+    for k in 0..3000 {
+        if k == 1500 {
+            q[2] += std::f64::consts::FRAC_PI_2; // the jump
+        }
+        // a constant push along the base's x axis, and the ideal base's measured world velocity
+        let (s, c) = q[2].sin_cos();
+        (tau[0], tau[1]) = (30.0 * c, 30.0 * s);
+        let t = r.update_base(&tau, &q, &qd, BASE_DT).unwrap().base_twist;
+        assert!(step_ok(prev, t), "step {k}: {prev:?} -> {t:?}");
+        prev = t;
+        (qd[0], qd[1]) = (c * t[0] - s * t[1], s * t[0] + c * t[1]);
+    }
+    assert!(prev[0] > 0.05 && prev[1].abs() < 1e-3, "still along base x: {prev:?}");
+    // and the safe stop keeps the direction in the base frame
+    let before = r.commands().base_twist;
+    let after = r.safe_stop_base(BASE_DT).base_twist;
+    assert!(step_ok(before, after) && after[0] < before[0]);
+    assert!((after[1] * before[0] - after[0] * before[1]).abs() < 1e-15, "{before:?} -> {after:?}");
+}
+
 #[test]
 fn resolver_position_limit_blocks_outward_allows_inward() {
     let (m, mut r) = first_order_setup();

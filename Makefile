@@ -12,7 +12,7 @@ MSG_SRCS := $(wildcard skin_msgs/msg/*.msg skin_msgs/srv/*.srv) skin_msgs/CMakeL
 MSG_SRCS += $(wildcard $(DEPS)/ros/install/.ros2-jazzy-python.stamp)
 CARGO_PROFILE ?= dev
 
-.PHONY: help bootstrap msgs build test test-rust test-robot-package test-integration run demo bench study clean fuzz test-fuzz
+.PHONY: help bootstrap msgs build lint test test-rust test-robot-package test-integration run demo bench study clean fuzz test-fuzz
 
 help:
 	@echo "make demo   bootstrap, build, run the main job: the intentional_contact scenario (see README.md)"
@@ -53,12 +53,18 @@ test-integration: build
 	@echo "[make] integration tests (test/, pytest with rclpy, rosbags, pinocchio, MuJoCo as outside peers)"
 	@$(ENV) SKIN_TARGET_DIR=$(TOP)/target/debug python -m pytest -q test
 
+# Formatting (rustfmt.toml) and lints (clippy, every warning an error).
+lint: msgs
+	@echo "[make] cargo fmt --check, cargo clippy -D warnings"
+	@$(ENV) cargo fmt --all --check
+	@$(ENV) cargo clippy --workspace --all-targets --quiet -- -D warnings
+
 # The robot package without MuJoCo (scripts/check_robot_package: dependencies and linked libraries).
 test-robot-package: build
 	@echo "[make] robot package skin_control without MuJoCo"
 	@$(ENV) scripts/check_robot_package
 
-test: test-rust test-robot-package test-integration test-fuzz
+test: lint test-rust test-robot-package test-integration test-fuzz
 	@echo "[make] all test suites passed"
 
 # Coverage-guided fuzzing of skin_core on the stable toolchain (docs/fuzzing.md); `make test` runs

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The ROS graph's figures for out/bench/summary.json (issue 6), with the release binaries
+"""The ROS graph's figures for out/bench/summary.json, with the release binaries
 `scripts/bench` builds:
 
 - ros_latency_p50_us, ros_latency_p99_us: task_controller (TOMM, trigger:=inputs) and the

@@ -5,8 +5,8 @@ Usage: bench_sim.py RELEASE_DIR SUMMARY_JSON
 
 Runs `skin_sim run <name> --out DIR` (release build, the whole scene at its own rates) for every
 scenario of `skin_sim list` and merges into SUMMARY_JSON (created if missing):
-- sim_realtime_factor_planar: intentional_contact (the planar arm of paper 000);
-- sim_realtime_factor_tomm: the slowest of the TOMM scenarios (paper 000 Figs. 5-6, paper 003);
+- sim_realtime_factor_planar: intentional_contact (the planar arm of intentional-contact paper);
+- sim_realtime_factor_tomm: the slowest of the TOMM scenarios (intentional-contact paper Figs. 5-6, interactive-force-control paper);
 - sim_realtime_factor_<name>: each scenario.
 The factor is simulated time over the wall time of the loop (set-up and output writing excluded),
 as skin_sim's metrics.json reports it; the best of RUNS runs per scenario (a run lasts 0.4-6 s:

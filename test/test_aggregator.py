@@ -2,7 +2,7 @@
 
 rclpy publishes skin cells (active ones, a NaN, an out-of-range value, an unknown id, a repeated
 id); the patch wrenches that come back are checked field by field against an independent
-computation from the layout YAML (paper 003 eq. 6-8: fused virtual forces along the outward
+computation from the layout YAML (interactive-force-control paper eq. 6-8: fused virtual forces along the outward
 normals, summed in the patch frame, their moments about the patch origin, the centroid and count
 of the active cells); the markers against the layout's link-frame cell positions and the colour
 rule; the parameters through the standard parameter services (list, get, describe, set valid,
@@ -64,7 +64,7 @@ def signals(reading):
 
 
 def expected_patches(layout, readings, w, threshold):
-    """Paper 003 eq. 6-8 per patch in the patch frame; `readings`: cell id -> (force[3], prox)."""
+    """Interactive-force-control paper eq. 6-8 per patch in the patch frame; `readings`: cell id -> (force[3], prox)."""
     out = {}
     for p in layout.patches:
         force, moment, positions = np.zeros(3), np.zeros(3), []

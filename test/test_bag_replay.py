@@ -2,7 +2,7 @@
 inputs played back with `skin_bag play` into freshly started skin_aggregator, task_controller
 and priority_supervisor, whose outputs must equal the recorded ones.
 
-Scenario: force_tracking_base_motion (paper 003 Exp. 1, TOMM: skin cells, joint states,
+Scenario: force_tracking_base_motion (interactive-force-control paper Exp. 1, TOMM: skin cells, joint states,
 odometry, LIDAR scan; /goal and /hand_force_reference, latched, when the scene sends them) for DURATION s of simulated time, with
 mujoco_sim --lockstep and task_controller trigger:=inputs, supervisor:=internal (the decision in
 the cycle: see test_graph.py for why a separate supervisor's timing is not reproducible).

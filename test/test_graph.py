@@ -2,7 +2,7 @@
 
 mujoco_sim --lockstep, task_controller (trigger:=inputs, supervisor:=internal) and
 priority_supervisor run as separate processes (and, second, composed in skin_stack) on the
-intentional_contact scenario (paper 000 Figs. 2-3, the planar arm) for 4 s of simulated time. The
+intentional_contact scenario (intentional-contact paper Figs. 2-3, the planar arm) for 4 s of simulated time. The
 commands mujoco_sim applied per period must equal, to 1e-9, those of `graph_reference`: the same
 loop in one process without DDS (every message conversion of the graph). skin_sim's ClosedLoop
 (no messages) is compared too, with the stated reason for its difference: the messages carry

@@ -86,14 +86,8 @@ fn message(bytes: &mut Bytes<'_>, layout: &ResolvedLayout) -> Option<Vec<Cell>> 
         .map(|_| {
             let tag = bytes.u8()?;
             let id = bytes.cell_id(layout, tag)?;
-            let force = (0..(tag >> 2) % 6)
-                .map(|_| bytes.signal())
-                .collect::<Option<_>>()?;
-            Some(Cell {
-                id,
-                force,
-                proximity: bytes.signal()?,
-            })
+            let force = (0..(tag >> 2) % 6).map(|_| bytes.signal()).collect::<Option<_>>()?;
+            Some(Cell { id, force, proximity: bytes.signal()? })
         })
         .collect()
 }
@@ -131,41 +125,19 @@ fn in_unit_range(v: f64) -> bool {
 fn check_wrenches(layout: &ResolvedLayout, wrenches: &[PatchWrench]) {
     assert_eq!(wrenches.len(), layout.patches().len());
     for (w, patch) in wrenches.iter().zip(layout.patches()) {
-        let finite = w
-            .force
-            .iter()
-            .chain(&w.moment)
-            .chain(&w.centroid)
-            .all(|v| v.is_finite());
+        let finite = w.force.iter().chain(&w.moment).chain(&w.centroid).all(|v| v.is_finite());
         assert!(finite, "patch {}: non-finite wrench {w:?}", patch.id);
-        assert!(
-            w.active_cells <= patch.cells.len(),
-            "patch {}: {w:?}",
-            patch.id
-        );
+        assert!(w.active_cells <= patch.cells.len(), "patch {}: {w:?}", patch.id);
         // Each active cell adds at most a unit normal times a signal <= 1.
-        assert!(
-            w.force.norm() <= w.active_cells as f64 + 1e-9,
-            "patch {}: {w:?}",
-            patch.id
-        );
-        assert!(
-            in_unit_range(w.max_force_signal) && in_unit_range(w.max_proximity_signal),
-            "{w:?}"
-        );
+        assert!(w.force.norm() <= w.active_cells as f64 + 1e-9, "patch {}: {w:?}", patch.id);
+        assert!(in_unit_range(w.max_force_signal) && in_unit_range(w.max_proximity_signal), "{w:?}");
     }
 }
 
 fn check_point_forces(forces: &[PointForce], bound_n: f64) {
     for f in forces {
-        assert!(
-            f.point.iter().chain(&f.force).all(|v| v.is_finite()),
-            "non-finite cell force {f:?}"
-        );
-        assert!(
-            f.force.norm() <= bound_n * (1.0 + 1e-9),
-            "cell force above {bound_n} N: {f:?}"
-        );
+        assert!(f.point.iter().chain(&f.force).all(|v| v.is_finite()), "non-finite cell force {f:?}");
+        assert!(f.force.norm() <= bound_n * (1.0 + 1e-9), "cell force above {bound_n} N: {f:?}");
     }
 }
 
@@ -181,15 +153,9 @@ pub fn check(data: &[u8]) {
     let fusion = FusionParams {
         weight_force: f64::from(w) / 255.0,
         activity_threshold: f64::from(threshold) / 256.0,
-        force_reduction: if flags & 1 == 0 {
-            ForceReduction::Mean
-        } else {
-            ForceReduction::Max
-        },
+        force_reduction: if flags & 1 == 0 { ForceReduction::Mean } else { ForceReduction::Max },
     };
-    fusion
-        .validate("fusion.")
-        .expect("decoded fusion parameters are valid");
+    fusion.validate("fusion.").expect("decoded fusion parameters are valid");
 
     let mut buf = CellBuffer::new(layout);
     let mut model = vec![CellReading::default(); layout.num_cells()];
@@ -197,11 +163,7 @@ pub fn check(data: &[u8]) {
     while let Some(msg) = message(&mut bytes, layout) {
         let before = *buf.issues();
         let mut reported: Vec<Issue> = Vec::new();
-        let samples = msg.iter().map(|c| CellSample {
-            cell_id: c.id,
-            force: &c.force,
-            proximity: c.proximity,
-        });
+        let samples = msg.iter().map(|c| CellSample { cell_id: c.id, force: &c.force, proximity: c.proximity });
         buf.update(layout, samples, |i| reported.push(*i));
 
         let mut want: Vec<(usize, IssueKind)> = Vec::new();
@@ -227,54 +189,24 @@ pub fn check(data: &[u8]) {
             assert_eq!(i.value.is_some(), signal_issue, "{i}");
         }
         let counts = buf.issues();
-        assert_eq!(
-            counts.total(),
-            before.total() + reported.len() as u64,
-            "{counts}"
-        );
+        assert_eq!(counts.total(), before.total() + reported.len() as u64, "{counts}");
         for kind in IssueKind::ALL {
             let n = reported.iter().filter(|i| i.kind == kind).count() as u64;
-            assert_eq!(
-                counts.get(kind),
-                before.get(kind) + n,
-                "{}: {counts}",
-                kind.name()
-            );
+            assert_eq!(counts.get(kind), before.get(kind) + n, "{}: {counts}", kind.name());
         }
         for (k, r) in buf.readings().iter().enumerate() {
-            assert!(
-                r.force.iter().all(|&v| in_unit_range(v)) && in_unit_range(r.proximity),
-                "cell {k}: {r:?}"
-            );
+            assert!(r.force.iter().all(|&v| in_unit_range(v)) && in_unit_range(r.proximity), "cell {k}: {r:?}");
         }
         assert_eq!(buf.readings(), &model[..], "readings differ from the rules");
 
-        aggregate_patches(layout, buf.readings(), &fusion, &mut wrenches)
-            .expect("one reading per cell");
+        aggregate_patches(layout, buf.readings(), &fusion, &mut wrenches).expect("one reading per cell");
         check_wrenches(layout, &wrenches);
         let pose = |f: usize| &t.frame_poses[f];
-        cell_repulsion_forces(
-            layout,
-            buf.readings(),
-            &skin.proximity,
-            &skin.repulsion,
-            pose,
-            &mut forces,
-        )
-        .expect("one reading per cell");
-        check_point_forces(
-            &forces,
-            skin.repulsion.gain_n_per_m * skin.repulsion.range_m,
-        );
-        cell_contact_forces(
-            layout,
-            buf.readings(),
-            &skin.force,
-            &fusion,
-            pose,
-            &mut forces,
-        )
-        .expect("one reading per cell");
+        cell_repulsion_forces(layout, buf.readings(), &skin.proximity, &skin.repulsion, pose, &mut forces)
+            .expect("one reading per cell");
+        check_point_forces(&forces, skin.repulsion.gain_n_per_m * skin.repulsion.range_m);
+        cell_contact_forces(layout, buf.readings(), &skin.force, &fusion, pose, &mut forces)
+            .expect("one reading per cell");
         check_point_forces(&forces, skin.force.max_n);
     }
 }

@@ -7,11 +7,11 @@
 
 use nalgebra::Vector2;
 use skin_core::controller::{Controller, ControllerConfig, ControllerInput, ControllerSetup};
+use skin_core::param_file::yaml;
 use skin_core::resolver::{Resolver, ResolverParams};
 use skin_core::skin::layout::{ResolvedLayout, SkinLayout};
 use skin_core::skin::params::SkinParams;
 use skin_core::skin::signals::CellReading;
-use skin_core::param_file::yaml;
 use skin_core::supervisor::{Supervisor, SupervisorParams};
 use skin_core::tasks::params::TaskParams;
 
@@ -34,59 +34,25 @@ fn build_with(edit: impl FnOnce(&mut ControllerConfig)) {
     let cells = vec![CellReading::uniform(0.5, 0.8); shipped.layout.num_cells()];
     let scan = [Vector2::new(0.6, 0.1)];
     for k in 1..=3 {
-        let input = ControllerInput {
-            t_s: 0.008 * f64::from(k),
-            dt_s: 0.008,
-            q,
-            qd: &qd,
-            cells: &cells,
-            scan: &scan,
-        };
+        let input = ControllerInput { t_s: 0.008 * f64::from(k), dt_s: 0.008, q, qd: &qd, cells: &cells, scan: &scan };
         let out = controller.update(&input);
         let c = &out.commands;
-        let finite = c
-            .joint_velocities
-            .iter()
-            .chain(&c.base_twist)
-            .all(|v| v.is_finite());
-        assert!(
-            finite,
-            "cycle {k}: non-finite commands {c:?} (fault {:?})",
-            out.fault
-        );
+        let finite = c.joint_velocities.iter().chain(&c.base_twist).all(|v| v.is_finite());
+        assert!(finite, "cycle {k}: non-finite commands {c:?} (fault {:?})", out.fault);
     }
 }
 
 /// Signals, distances and forces to evaluate the characteristics at.
-const PROBES: [f64; 9] = [
-    f64::NAN,
-    f64::NEG_INFINITY,
-    -1.0,
-    0.0,
-    1e-300,
-    0.01,
-    0.5,
-    1.0,
-    f64::INFINITY,
-];
+const PROBES: [f64; 9] = [f64::NAN, f64::NEG_INFINITY, -1.0, 0.0, 1e-300, 0.01, 0.5, 1.0, f64::INFINITY];
 
 fn check_skin_params(p: &SkinParams) {
     p.validate().expect("parsed skin model validates");
     let (prox, force, rep) = (&p.proximity, &p.force, &p.repulsion);
-    for x in PROBES
-        .into_iter()
-        .chain([prox.range_m, force.max_n, p.repulsion.range_m])
-    {
+    for x in PROBES.into_iter().chain([prox.range_m, force.max_n, p.repulsion.range_m]) {
         let d = prox.distance_m(x);
-        assert!(
-            (0.0..=prox.range_m).contains(&d),
-            "proximity distance_m({x}) = {d}: {p:?}"
-        );
+        assert!((0.0..=prox.range_m).contains(&d), "proximity distance_m({x}) = {d}: {p:?}");
         let f = force.force_n(x);
-        assert!(
-            (0.0..=force.max_n).contains(&f),
-            "force_n({x}) = {f}: {p:?}"
-        );
+        assert!((0.0..=force.max_n).contains(&f), "force_n({x}) = {f}: {p:?}");
         for s in [prox.signal(x), force.signal(x)] {
             assert!((0.0..=1.0).contains(&s), "signal({x}) = {s}: {p:?}");
         }
@@ -99,8 +65,7 @@ fn check_skin_params(p: &SkinParams) {
 
 fn check_layout(l: &SkinLayout) {
     l.validate().expect("parsed layout validates");
-    l.resolve_with(|_| Some(0))
-        .expect("a validated layout resolves when every link exists");
+    l.resolve_with(|_| Some(0)).expect("a validated layout resolves when every link exists");
     if let Ok(resolved) = l.resolve(&tomm().config.model) {
         check_resolved(&resolved);
         build_with(|c| c.layout = resolved);
@@ -110,11 +75,7 @@ fn check_layout(l: &SkinLayout) {
 fn check_resolved(r: &ResolvedLayout) {
     let mut next = 0;
     for (k, p) in r.patches().iter().enumerate() {
-        assert_eq!(
-            p.cells.start, next,
-            "patch {}: cells are grouped by patch",
-            p.id
-        );
+        assert_eq!(p.cells.start, next, "patch {}: cells are grouped by patch", p.id);
         next = p.cells.end;
         assert_eq!(r.patch_index(p.id), Some(k));
     }
@@ -122,22 +83,10 @@ fn check_resolved(r: &ResolvedLayout) {
     for (i, c) in r.cells().iter().enumerate() {
         assert_eq!(r.cell_index(c.id), Some(i), "cell {}", c.id);
         for n in [c.normal_patch, c.normal_link] {
-            assert!(
-                (n.norm() - 1.0).abs() < 1e-9,
-                "cell {}: normal {n:?} is not a unit vector",
-                c.id
-            );
+            assert!((n.norm() - 1.0).abs() < 1e-9, "cell {}: normal {n:?} is not a unit vector", c.id);
         }
-        let poses = [
-            c.link_from_cell.translation.vector,
-            c.position_link,
-            c.position_patch,
-        ];
-        assert!(
-            poses.iter().all(|v| v.iter().all(|x| x.is_finite())),
-            "cell {}: {c:?}",
-            c.id
-        );
+        let poses = [c.link_from_cell.translation.vector, c.position_link, c.position_patch];
+        assert!(poses.iter().all(|v| v.iter().all(|x| x.is_finite())), "cell {}: {c:?}", c.id);
     }
 }
 

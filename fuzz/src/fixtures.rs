@@ -21,18 +21,13 @@ pub fn tomm() -> &'static Tomm {
     static TOMM: OnceLock<Tomm> = OnceLock::new();
     TOMM.get_or_init(|| {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/controller/tomm.yaml");
-        let config = ControllerConfig::load(&path)
-            .unwrap_or_else(|e| panic!("fixture {}: {e}", path.display()));
+        let config = ControllerConfig::load(&path).unwrap_or_else(|e| panic!("fixture {}: {e}", path.display()));
         let model = &config.model;
         let mut data = ModelData::new(model);
         let qd = vec![0.0; model.nv()];
-        update_kinematics(model, &mut data, &config.setup.posture, &qd)
-            .expect("posture of the shipped setup");
+        update_kinematics(model, &mut data, &config.setup.posture, &qd).expect("posture of the shipped setup");
         let frame_poses = (0..model.nframes()).map(|f| *data.frame_pose(f)).collect();
-        Tomm {
-            config,
-            frame_poses,
-        }
+        Tomm { config, frame_poses }
     })
 }
 

@@ -14,18 +14,10 @@ fn check_model(m: &RobotModel) {
     for j in 0..nv {
         let l = &m.joint_limits()[j];
         assert!(l.lower <= l.upper, "joint {}: {l:?}", m.joint_names()[j]);
-        assert!(
-            (m.joint_axis(j).norm() - 1.0).abs() < 1e-9,
-            "joint {}: axis",
-            m.joint_names()[j]
-        );
+        assert!((m.joint_axis(j).norm() - 1.0).abs() < 1e-9, "joint {}: axis", m.joint_names()[j]);
         // massless bodies are allowed when their descendants make M positive definite
         let mass = m.body_mass(j);
-        assert!(
-            mass.is_finite() && mass >= 0.0,
-            "joint {}: body mass {mass}",
-            m.joint_names()[j]
-        );
+        assert!(mass.is_finite() && mass >= 0.0, "joint {}: body mass {mass}", m.joint_names()[j]);
         assert_eq!(m.joint_index(&m.joint_names()[j]), Some(j));
     }
     let mut data = ModelData::new(m);

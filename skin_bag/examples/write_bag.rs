@@ -12,21 +12,11 @@ use skin_bag::{read_bag, BagMessage, BagWriter, RosMessage};
 
 /// Something done with each sample message: writing it, or checking a bag holds it.
 trait Visit {
-    fn visit<M: RosMessage + PartialEq + Debug>(
-        &mut self,
-        topic: &str,
-        t_ns: u64,
-        msg: M,
-    ) -> Result<()>;
+    fn visit<M: RosMessage + PartialEq + Debug>(&mut self, topic: &str, t_ns: u64, msg: M) -> Result<()>;
 }
 
 impl Visit for BagWriter {
-    fn visit<M: RosMessage + PartialEq + Debug>(
-        &mut self,
-        topic: &str,
-        t_ns: u64,
-        msg: M,
-    ) -> Result<()> {
+    fn visit<M: RosMessage + PartialEq + Debug>(&mut self, topic: &str, t_ns: u64, msg: M) -> Result<()> {
         Ok(self.write(topic, t_ns, &msg)?)
     }
 }
@@ -35,23 +25,10 @@ impl Visit for BagWriter {
 struct Check(Vec<BagMessage>);
 
 impl Visit for Check {
-    fn visit<M: RosMessage + PartialEq + Debug>(
-        &mut self,
-        topic: &str,
-        t_ns: u64,
-        want: M,
-    ) -> Result<()> {
-        let i = self
-            .0
-            .iter()
-            .position(|m| m.topic == topic)
-            .with_context(|| format!("no message on {topic}"))?;
+    fn visit<M: RosMessage + PartialEq + Debug>(&mut self, topic: &str, t_ns: u64, want: M) -> Result<()> {
+        let i = self.0.iter().position(|m| m.topic == topic).with_context(|| format!("no message on {topic}"))?;
         let found = self.0.remove(i);
-        ensure!(
-            found.log_time_ns == t_ns,
-            "{topic}: log time {} ns, expected {t_ns}",
-            found.log_time_ns
-        );
+        ensure!(found.log_time_ns == t_ns, "{topic}: log time {} ns, expected {t_ns}", found.log_time_ns);
         let got: M = found.decode()?;
         ensure!(got == want, "{topic}:\n got  {got:?}\n want {want:?}");
         println!("ok {topic}");
@@ -60,13 +37,7 @@ impl Visit for Check {
 }
 
 fn header(sec: i32, frame: &str) -> Header {
-    Header {
-        stamp: Time {
-            sec,
-            nanosec: 250_000_000,
-        },
-        frame_id: frame.into(),
-    }
+    Header { stamp: Time { sec, nanosec: 250_000_000 }, frame_id: frame.into() }
 }
 
 fn v3(x: f64, y: f64, z: f64) -> Vector3 {
@@ -76,13 +47,7 @@ fn v3(x: f64, y: f64, z: f64) -> Vector3 {
 /// Every topic, in the order written; times 1..=10 s. Floats of `float32` fields are exact in f32.
 fn samples(v: &mut impl Visit) -> Result<()> {
     const S: u64 = 1_000_000_000;
-    v.visit(
-        "/clock",
-        S,
-        Clock {
-            clock: Time { sec: 1, nanosec: 0 },
-        },
-    )?;
+    v.visit("/clock", S, Clock { clock: Time { sec: 1, nanosec: 0 } })?;
     v.visit(
         "/joint_states",
         2 * S,
@@ -101,22 +66,11 @@ fn samples(v: &mut impl Visit) -> Result<()> {
             header: header(3, "odom"),
             child_frame_id: "base_link".into(),
             pose: PoseWithCovariance {
-                pose: Pose {
-                    position: v3(1.5, -0.5, 0.0),
-                    orientation: Quaternion {
-                        x: 0.0,
-                        y: 0.0,
-                        z: 0.6,
-                        w: 0.8,
-                    },
-                },
+                pose: Pose { position: v3(1.5, -0.5, 0.0), orientation: Quaternion { x: 0.0, y: 0.0, z: 0.6, w: 0.8 } },
                 covariance: std::array::from_fn(|i| i as f64 * 0.5),
             },
             twist: TwistWithCovariance {
-                twist: Twist {
-                    linear: v3(0.2, 0.1, 0.0),
-                    angular: v3(0.0, 0.0, 0.3),
-                },
+                twist: Twist { linear: v3(0.2, 0.1, 0.0), angular: v3(0.0, 0.0, 0.3) },
                 covariance: std::array::from_fn(|i| if i % 7 == 0 { 0.01 } else { 0.0 }),
             },
         },
@@ -158,10 +112,7 @@ fn samples(v: &mut impl Visit) -> Result<()> {
                 header: header(6, "patch_3"),
                 patch_id: 3,
                 link: "right_forearm_link".into(),
-                wrench: Wrench {
-                    force: v3(0.0, 0.0, 2.0),
-                    torque: v3(0.1, -0.2, 0.0),
-                },
+                wrench: Wrench { force: v3(0.0, 0.0, 2.0), torque: v3(0.1, -0.2, 0.0) },
                 centroid: v3(0.01, 0.02, 0.0),
                 active_cells: 4,
                 max_force: 0.5,
@@ -174,34 +125,20 @@ fn samples(v: &mut impl Visit) -> Result<()> {
         7 * S,
         Float64MultiArray {
             layout: MultiArrayLayout {
-                dim: vec![MultiArrayDimension {
-                    label: "joints".into(),
-                    size: 6,
-                    stride: 6,
-                }],
+                dim: vec![MultiArrayDimension { label: "joints".into(), size: 6, stride: 6 }],
                 data_offset: 0,
             },
             data: vec![0.1, -0.2, 0.3, -0.4, 0.5, -0.6],
         },
     )?;
-    v.visit(
-        "/base/cmd_vel",
-        8 * S,
-        Twist {
-            linear: v3(0.1, -0.05, 0.0),
-            angular: v3(0.0, 0.0, 0.2),
-        },
-    )?;
+    v.visit("/base/cmd_vel", 8 * S, Twist { linear: v3(0.1, -0.05, 0.0), angular: v3(0.0, 0.0, 0.2) })?;
     v.visit(
         "/supervisor/arrangement",
         9 * S,
         Arrangement {
             mode: 1,
             task_order: vec!["goal".into(), "contact_reaction".into(), "avoidance".into()],
-            switch_time: Time {
-                sec: 8,
-                nanosec: 500_000_000,
-            },
+            switch_time: Time { sec: 8, nanosec: 500_000_000 },
             smoothing_gain: 5.0,
             sensing_range: 0.05,
             fusion_weight: 0.75,
@@ -220,18 +157,8 @@ fn samples(v: &mut impl Visit) -> Result<()> {
             torque_norm: 42.0,
             goal_error: -1.0,
             tasks: vec![
-                TaskState {
-                    name: "contact_reaction".into(),
-                    priority: 1,
-                    error_norm: 2.5,
-                    torque_norm: 30.0,
-                },
-                TaskState {
-                    name: "goal".into(),
-                    priority: 2,
-                    error_norm: 0.2,
-                    torque_norm: 12.0,
-                },
+                TaskState { name: "contact_reaction".into(), priority: 1, error_norm: 2.5, torque_norm: 30.0 },
+                TaskState { name: "goal".into(), priority: 2, error_norm: 0.2, torque_norm: 12.0 },
             ],
             input_status: 2,
             safe_stop_cycles: 3,
@@ -248,11 +175,7 @@ fn main() -> Result<()> {
         [flag, path] if flag == "--check" => {
             let mut check = Check(read_bag(path)?);
             samples(&mut check)?;
-            ensure!(
-                check.0.is_empty(),
-                "{path}: {} unexpected messages",
-                check.0.len()
-            );
+            ensure!(check.0.is_empty(), "{path}: {} unexpected messages", check.0.len());
         }
         [path] => {
             let mut bag = BagWriter::create(path)?;

@@ -19,9 +19,7 @@ pub fn encode<M: Serialize>(msg: &M) -> Result<Vec<u8>, String> {
 pub fn decode<M: DeserializeOwned>(data: &[u8]) -> Result<M, String> {
     match data.split_first_chunk::<4>() {
         Some((header, payload)) if header[..2] == CDR_LE[..2] => {
-            cdr_encoding::from_bytes::<M, LittleEndian>(payload)
-                .map(|(msg, _)| msg)
-                .map_err(|e| e.to_string())
+            cdr_encoding::from_bytes::<M, LittleEndian>(payload).map(|(msg, _)| msg).map_err(|e| e.to_string())
         }
         Some((header, _)) => Err(format!("unsupported CDR encapsulation {header:02x?}")),
         None => Err(format!("{} bytes: shorter than the CDR header", data.len())),

@@ -7,20 +7,14 @@ use std::collections::BTreeSet;
 /// `(pkg/Type, .msg text)` of a standard Jazzy message (copied under `assets/ros_msgs`).
 macro_rules! std_msg {
     ($pkg:literal, $ty:literal) => {
-        (
-            concat!($pkg, "/", $ty),
-            include_str!(concat!("../assets/ros_msgs/", $pkg, "/", $ty, ".msg")),
-        )
+        (concat!($pkg, "/", $ty), include_str!(concat!("../assets/ros_msgs/", $pkg, "/", $ty, ".msg")))
     };
 }
 
 /// `(skin_msgs/Type, .msg text)` read from the interface package itself, so it never drifts.
 macro_rules! skin_msg {
     ($ty:literal) => {
-        (
-            concat!("skin_msgs/", $ty),
-            include_str!(concat!("../../skin_msgs/msg/", $ty, ".msg")),
-        )
+        (concat!("skin_msgs/", $ty), include_str!(concat!("../../skin_msgs/msg/", $ty, ".msg")))
     };
 }
 
@@ -62,17 +56,14 @@ const DEFINITIONS: &[(&str, &str)] = &[
 ];
 
 const PRIMITIVES: &[&str] = &[
-    "bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16", "uint16", "int32",
-    "uint32", "int64", "uint64", "string", "wstring",
+    "bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64",
+    "uint64", "string", "wstring",
 ];
 
 /// The `.msg` text of `pkg/Type` (or `pkg/msg/Type`), if it is one of ours.
 pub fn msg_text(type_name: &str) -> Option<&'static str> {
     let key = type_name.replacen("/msg/", "/", 1);
-    DEFINITIONS
-        .iter()
-        .find(|(name, _)| *name == key)
-        .map(|(_, text)| *text)
+    DEFINITIONS.iter().find(|(name, _)| *name == key).map(|(_, text)| *text)
 }
 
 /// The complete `ros2msg` definition of `type_name` (`pkg/msg/Type`) as rosbag2 writes it into
@@ -106,13 +97,7 @@ fn dependencies(text: &str, package: &str) -> BTreeSet<String> {
         // Strip an array suffix (`[]`, `[3]`, `[<=5]`) and a string bound (`string<=8`).
         .map(|ty| ty.split(['[', '<']).next().unwrap_or(ty))
         .filter(|ty| !PRIMITIVES.contains(ty))
-        .map(|ty| {
-            if ty.contains('/') {
-                ty.to_string()
-            } else {
-                format!("{package}/{ty}")
-            }
-        })
+        .map(|ty| if ty.contains('/') { ty.to_string() } else { format!("{package}/{ty}") })
         .collect()
 }
 
@@ -145,11 +130,7 @@ mod tests {
     #[test]
     fn skin_types_resolve_their_package_local_dependencies() {
         let full = full_definition("skin_msgs/msg/PatchWrenchArray").unwrap();
-        for dep in [
-            "skin_msgs/PatchWrench",
-            "geometry_msgs/Wrench",
-            "geometry_msgs/Point",
-        ] {
+        for dep in ["skin_msgs/PatchWrench", "geometry_msgs/Wrench", "geometry_msgs/Point"] {
             assert!(full.contains(&format!("MSG: {dep}\n")), "{dep} missing");
         }
         // Constants are primitives, not dependencies.
@@ -159,9 +140,6 @@ mod tests {
 
     #[test]
     fn unknown_type_is_named() {
-        assert_eq!(
-            full_definition("foo_msgs/msg/Bar"),
-            Err("foo_msgs/Bar".to_string())
-        );
+        assert_eq!(full_definition("foo_msgs/msg/Bar"), Err("foo_msgs/Bar".to_string()));
     }
 }

@@ -48,10 +48,7 @@ impl Time {
     /// The time `ns` nanoseconds after the epoch (sim time starts at 0).
     pub fn from_nanos(ns: u64) -> Self {
         // i32 seconds last until 2038 (wall clock) or 68 years of sim time.
-        Self {
-            sec: (ns / 1_000_000_000) as i32,
-            nanosec: (ns % 1_000_000_000) as u32,
-        }
+        Self { sec: (ns / 1_000_000_000) as i32, nanosec: (ns % 1_000_000_000) as u32 }
     }
 }
 
@@ -116,12 +113,7 @@ pub struct Quaternion {
 impl Default for Quaternion {
     /// The identity rotation (the `.msg` default).
     fn default() -> Self {
-        Self {
-            x: 0.0,
-            y: 0.0,
-            z: 0.0,
-            w: 1.0,
-        }
+        Self { x: 0.0, y: 0.0, z: 0.0, w: 1.0 }
     }
 }
 
@@ -166,19 +158,13 @@ pub struct TwistWithCovariance {
 // serde and Default stop at 32-element arrays: the covariances need these by hand.
 impl Default for PoseWithCovariance {
     fn default() -> Self {
-        Self {
-            pose: Pose::default(),
-            covariance: [0.0; 36],
-        }
+        Self { pose: Pose::default(), covariance: [0.0; 36] }
     }
 }
 
 impl Default for TwistWithCovariance {
     fn default() -> Self {
-        Self {
-            twist: Twist::default(),
-            covariance: [0.0; 36],
-        }
+        Self { twist: Twist::default(), covariance: [0.0; 36] }
     }
 }
 
@@ -534,9 +520,7 @@ mod fixed_array {
         t.end()
     }
 
-    pub fn deserialize<'de, D: Deserializer<'de>, const N: usize>(
-        d: D,
-    ) -> Result<[f64; N], D::Error> {
+    pub fn deserialize<'de, D: Deserializer<'de>, const N: usize>(d: D) -> Result<[f64; N], D::Error> {
         struct ArrayVisitor<const N: usize>;
         impl<'de, const N: usize> Visitor<'de> for ArrayVisitor<N> {
             type Value = [f64; N];
@@ -546,9 +530,7 @@ mod fixed_array {
             fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
                 let mut out = [0.0; N];
                 for (i, v) in out.iter_mut().enumerate() {
-                    *v = seq
-                        .next_element()?
-                        .ok_or_else(|| A::Error::invalid_length(i, &self))?;
+                    *v = seq.next_element()?.ok_or_else(|| A::Error::invalid_length(i, &self))?;
                 }
                 Ok(out)
             }

@@ -43,21 +43,12 @@ impl BagMessage {
 /// Chunks must be uncompressed, as rosbags and this crate write them.
 pub fn read_bag(path: impl AsRef<Path>) -> Result<Vec<BagMessage>, BagError> {
     let path = path.as_ref().to_path_buf();
-    let bytes = std::fs::read(&path).map_err(|source| BagError::Io {
-        path: path.clone(),
-        source,
-    })?;
-    let stream = mcap::MessageStream::new(&bytes).map_err(|source| BagError::Mcap {
-        path: path.clone(),
-        source,
-    })?;
+    let bytes = std::fs::read(&path).map_err(|source| BagError::Io { path: path.clone(), source })?;
+    let stream = mcap::MessageStream::new(&bytes).map_err(|source| BagError::Mcap { path: path.clone(), source })?;
     let shared: Arc<Path> = Arc::from(path.as_path());
     let mut out = Vec::new();
     for message in stream {
-        let message = message.map_err(|source| BagError::Mcap {
-            path: path.clone(),
-            source,
-        })?;
+        let message = message.map_err(|source| BagError::Mcap { path: path.clone(), source })?;
         let channel = &message.channel;
         if channel.message_encoding != "cdr" {
             return Err(BagError::Encoding {
@@ -69,11 +60,7 @@ pub fn read_bag(path: impl AsRef<Path>) -> Result<Vec<BagMessage>, BagError> {
         out.push(BagMessage {
             path: shared.clone(),
             topic: channel.topic.clone(),
-            type_name: channel
-                .schema
-                .as_ref()
-                .map(|s| s.name.clone())
-                .unwrap_or_default(),
+            type_name: channel.schema.as_ref().map(|s| s.name.clone()).unwrap_or_default(),
             log_time_ns: message.log_time,
             data: message.data.into_owned(),
         });

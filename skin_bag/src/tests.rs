@@ -2,32 +2,19 @@ use super::msgs::*;
 use super::*;
 
 fn header(ns: u64, frame: &str) -> Header {
-    Header {
-        stamp: Time::from_nanos(ns),
-        frame_id: frame.to_string(),
-    }
+    Header { stamp: Time::from_nanos(ns), frame_id: frame.to_string() }
 }
 
 #[test]
 fn clock_bytes_are_the_cdr_header_then_two_le_words() {
-    let msg = Clock {
-        clock: Time { sec: 1, nanosec: 2 },
-    };
-    assert_eq!(
-        cdr::encode(&msg).unwrap(),
-        [0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0]
-    );
+    let msg = Clock { clock: Time { sec: 1, nanosec: 2 } };
+    assert_eq!(cdr::encode(&msg).unwrap(), [0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0]);
 }
 
 #[test]
 fn float64_after_a_byte_is_aligned_to_8_from_the_payload_start() {
     // stamp (8) + string length (4) + "a\0" (2) + mode (1) = 15: one padding byte before blend.
-    let msg = ControllerState {
-        header: header(0, "a"),
-        mode: 7,
-        blend: 0.5,
-        ..Default::default()
-    };
+    let msg = ControllerState { header: header(0, "a"), mode: 7, blend: 0.5, ..Default::default() };
     let bytes = cdr::encode(&msg).unwrap();
     let payload = &bytes[4..];
     assert_eq!(&payload[8..14], &[2, 0, 0, 0, b'a', 0]);
@@ -45,14 +32,7 @@ fn every_topic_type_round_trips_through_a_file() {
         header: header(5, "odom"),
         child_frame_id: "base_link".into(),
         pose: PoseWithCovariance {
-            pose: Pose {
-                position: Point {
-                    x: 1.0,
-                    y: 2.0,
-                    z: 0.0,
-                },
-                orientation: Quaternion::default(),
-            },
+            pose: Pose { position: Point { x: 1.0, y: 2.0, z: 0.0 }, orientation: Quaternion::default() },
             covariance: std::array::from_fn(|i| i as f64),
         },
         twist: TwistWithCovariance::default(),
@@ -68,12 +48,7 @@ fn every_topic_type_round_trips_through_a_file() {
     let state = ControllerState {
         header: header(5, ""),
         mode: 1,
-        tasks: vec![TaskState {
-            name: "goal".into(),
-            priority: 1,
-            error_norm: 0.2,
-            torque_norm: 3.0,
-        }],
+        tasks: vec![TaskState { name: "goal".into(), priority: 1, error_norm: 0.2, torque_norm: 3.0 }],
         ..Default::default()
     };
     let mut bag = BagWriter::create(&path).unwrap();
@@ -84,19 +59,8 @@ fn every_topic_type_round_trips_through_a_file() {
     bag.finish().unwrap();
 
     let msgs = read_bag(&path).unwrap();
-    let topics: Vec<(&str, u64)> = msgs
-        .iter()
-        .map(|m| (m.topic.as_str(), m.log_time_ns))
-        .collect();
-    assert_eq!(
-        topics,
-        [
-            ("/controller/state", 4),
-            ("/base/odom", 5),
-            ("/skin/cells", 5),
-            ("/controller/state", 6)
-        ]
-    );
+    let topics: Vec<(&str, u64)> = msgs.iter().map(|m| (m.topic.as_str(), m.log_time_ns)).collect();
+    assert_eq!(topics, [("/controller/state", 4), ("/base/odom", 5), ("/skin/cells", 5), ("/controller/state", 6)]);
     assert_eq!(msgs[0].decode::<ControllerState>().unwrap(), state);
     assert_eq!(msgs[1].decode::<Odometry>().unwrap(), odom);
     assert_eq!(msgs[2].decode::<SkinCellArray>().unwrap(), cells);
@@ -110,22 +74,13 @@ fn a_topic_keeps_its_type_and_errors_name_file_and_topic() {
     let path = dir.join("types.mcap");
     let mut bag = BagWriter::create(&path).unwrap();
     bag.write("/clock", 0, &Clock::default()).unwrap();
-    let err = bag
-        .write("/clock", 1, &Twist::default())
-        .unwrap_err()
-        .to_string();
-    assert!(
-        err.contains("types.mcap") && err.contains("/clock"),
-        "{err}"
-    );
+    let err = bag.write("/clock", 1, &Twist::default()).unwrap_err().to_string();
+    assert!(err.contains("types.mcap") && err.contains("/clock"), "{err}");
     bag.finish().unwrap();
 
     let msgs = read_bag(&path).unwrap();
     let err = msgs[0].decode::<Twist>().unwrap_err().to_string();
-    assert!(
-        err.contains("rosgraph_msgs/msg/Clock") && err.contains("types.mcap"),
-        "{err}"
-    );
+    assert!(err.contains("rosgraph_msgs/msg/Clock") && err.contains("types.mcap"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -159,9 +114,7 @@ fn tf_markers_and_a_latched_description_round_trip() {
         colors: vec![ColorRgba { r: 1.0, g: 0.5, b: 0.5, a: 1.0 }],
         ..Default::default()
     };
-    let markers = MarkerArray {
-        markers: vec![Marker { action: Marker::DELETEALL, ..Default::default() }, cells],
-    };
+    let markers = MarkerArray { markers: vec![Marker { action: Marker::DELETEALL, ..Default::default() }, cells] };
     let description = StringMsg { data: "<robot name=\"r\"/>".into() };
     let mut bag = BagWriter::create(&path).unwrap();
     let definition = full_definition(StringMsg::TYPE_NAME).unwrap();

@@ -10,7 +10,8 @@ use super::{cdr, defs, BagError, RosMessage};
 /// The offered QoS of a latched publisher (reliable, transient local, depth 1) in rosbag2's YAML,
 /// for [`BagWriter::add_topic`]: a player re-offers it, so late subscribers (RViz's robot model
 /// on `/robot_description`) still get the message.
-pub const TRANSIENT_LOCAL_QOS: &str = "- history: keep_last\n  depth: 1\n  reliability: reliable\n  durability: transient_local\n  \
+pub const TRANSIENT_LOCAL_QOS: &str =
+    "- history: keep_last\n  depth: 1\n  reliability: reliable\n  durability: transient_local\n  \
 deadline:\n    sec: 9223372036\n    nsec: 854775807\n  lifespan:\n    sec: 9223372036\n    nsec: 854775807\n  \
 liveliness: automatic\n  liveliness_lease_duration:\n    sec: 9223372036\n    nsec: 854775807\n  \
 avoid_ros_namespace_conventions: false\n";
@@ -38,37 +39,21 @@ impl BagWriter {
     /// Create (or truncate) the bag file at `path` (by convention `*.mcap`).
     pub fn create(path: impl AsRef<Path>) -> Result<Self, BagError> {
         let path = path.as_ref().to_path_buf();
-        let file = File::create(&path).map_err(|source| BagError::Io {
-            path: path.clone(),
-            source,
-        })?;
+        let file = File::create(&path).map_err(|source| BagError::Io { path: path.clone(), source })?;
         // Uncompressed chunks: every MCAP reader takes them, and the crate needs no C codecs.
         let mcap = mcap::WriteOptions::new()
             .profile("ros2")
             .library(concat!("skin_bag ", env!("CARGO_PKG_VERSION")))
             .compression(None)
             .create(BufWriter::new(file))
-            .map_err(|source| BagError::Mcap {
-                path: path.clone(),
-                source,
-            })?;
-        Ok(Self {
-            path,
-            mcap,
-            schemas: HashMap::new(),
-            channels: BTreeMap::new(),
-        })
+            .map_err(|source| BagError::Mcap { path: path.clone(), source })?;
+        Ok(Self { path, mcap, schemas: HashMap::new(), channels: BTreeMap::new() })
     }
 
     /// Write `msg` on `topic`, received and published at `t_ns` (ns; sim time or wall clock).
     /// The topic is registered on first use with its type's definition and no QoS (the player's
     /// defaults).
-    pub fn write<M: RosMessage>(
-        &mut self,
-        topic: &str,
-        t_ns: u64,
-        msg: &M,
-    ) -> Result<(), BagError> {
+    pub fn write<M: RosMessage>(&mut self, topic: &str, t_ns: u64, msg: &M) -> Result<(), BagError> {
         let data = cdr::encode(msg).map_err(|message| BagError::Cdr {
             path: self.path.clone(),
             topic: topic.to_string(),
@@ -99,44 +84,34 @@ impl BagWriter {
     /// Registers `topic` (before its first message) with its type, the type's full definition
     /// as rosbag2 stores it, and the publishers' offered QoS (rosbag2's YAML text; empty: the
     /// player's defaults).
-    pub fn add_topic(&mut self, topic: &str, type_name: &str, definition: &str, offered_qos: &str) -> Result<(), BagError> {
+    pub fn add_topic(
+        &mut self,
+        topic: &str,
+        type_name: &str,
+        definition: &str,
+        offered_qos: &str,
+    ) -> Result<(), BagError> {
         let path = self.path.clone();
         let mcap_error = move |source| BagError::Mcap { path: path.clone(), source };
         let schema = match self.schemas.get(type_name) {
             Some(&id) => id,
             None => {
-                let id = self
-                    .mcap
-                    .add_schema(type_name, "ros2msg", definition.as_bytes())
-                    .map_err(&mcap_error)?;
+                let id = self.mcap.add_schema(type_name, "ros2msg", definition.as_bytes()).map_err(&mcap_error)?;
                 self.schemas.insert(type_name.to_string(), id);
                 id
             }
         };
         let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), offered_qos.to_string())]);
-        let id = self
-            .mcap
-            .add_channel(schema, topic, "cdr", &metadata)
-            .map_err(&mcap_error)?;
-        self.channels.insert(
-            topic.to_string(),
-            Channel {
-                id,
-                type_name: type_name.to_string(),
-                sequence: 0,
-                count: 0,
-            },
-        );
+        let id = self.mcap.add_channel(schema, topic, "cdr", &metadata).map_err(&mcap_error)?;
+        self.channels
+            .insert(topic.to_string(), Channel { id, type_name: type_name.to_string(), sequence: 0, count: 0 });
         Ok(())
     }
 
     /// Writes one serialized message (CDR with its encapsulation header) of a registered topic.
     pub fn write_raw(&mut self, topic: &str, t_ns: u64, data: &[u8]) -> Result<(), BagError> {
         let Some(channel) = self.channels.get_mut(topic) else {
-            return Err(BagError::Unregistered {
-                path: self.path.clone(),
-                topic: topic.to_string(),
-            });
+            return Err(BagError::Unregistered { path: self.path.clone(), topic: topic.to_string() });
         };
         channel.sequence = channel.sequence.wrapping_add(1);
         channel.count += 1;
@@ -148,10 +123,7 @@ impl BagWriter {
         };
         self.mcap
             .write_to_known_channel(&header, data)
-            .map_err(|source| BagError::Mcap {
-                path: self.path.clone(),
-                source,
-            })
+            .map_err(|source| BagError::Mcap { path: self.path.clone(), source })
     }
 
     /// Messages written per topic, in topic order.
@@ -162,17 +134,8 @@ impl BagWriter {
     /// Write the summary and close the file.
     pub fn finish(mut self) -> Result<(), BagError> {
         let path = self.path.clone();
-        self.mcap.finish().map_err(|source| BagError::Mcap {
-            path: path.clone(),
-            source,
-        })?;
-        self.mcap
-            .into_inner()
-            .into_inner()
-            .map_err(|e| BagError::Io {
-                path,
-                source: e.into_error(),
-            })?;
+        self.mcap.finish().map_err(|source| BagError::Mcap { path: path.clone(), source })?;
+        self.mcap.into_inner().into_inner().map_err(|e| BagError::Io { path, source: e.into_error() })?;
         Ok(())
     }
 }

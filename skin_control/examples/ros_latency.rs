@@ -1,4 +1,4 @@
-//! Latency of the ROS graph (issue 6 bench): a probe publishes the task controller's inputs for
+//! Latency of the ROS graph (make bench): a probe publishes the task controller's inputs for
 //! TOMM at 250 Hz, a 718-cell `/skin/cells` last (it completes the input set of a period), and
 //! times from that publish to the right arm's command (`Float64MultiArray`) that the cycle sends.
 //! One period at a time, so every command belongs to the period just sent. Start the controller
@@ -46,7 +46,8 @@ fn main() -> Result<()> {
     let odom_pub = node.create_publisher::<Odometry>("/base/odom", qos::stream())?;
     let scan_pub = node.create_publisher::<LaserScan>("/scan", qos::stream())?;
     let cells_pub = node.create_publisher::<SkinCellArray>("/skin/cells", qos::stream())?;
-    let mut commands = node.subscribe::<Float64MultiArray>("/right_arm/forward_velocity_controller/commands", qos::stream())?;
+    let mut commands =
+        node.subscribe::<Float64MultiArray>("/right_arm/forward_velocity_controller/commands", qos::stream())?;
 
     // the robot at its posture, at rest; a dozen cells see something (the avoidance level is
     // filled), every cell is in the message (the whole conversion and aggregation path)
@@ -59,7 +60,16 @@ fn main() -> Result<()> {
     };
     let mut odom = Odometry::default();
     odom.pose.pose.orientation.w = 1.0;
-    let mut scan = LaserScan { header: r2r::std_msgs::msg::Header { frame_id: "laser".into(), ..Default::default() }, angle_min: -std::f32::consts::PI, angle_max: std::f32::consts::PI, angle_increment: std::f32::consts::TAU / 360.0, range_min: 0.05, range_max: 8.0, ranges: vec![8.5; 360], ..Default::default() };
+    let mut scan = LaserScan {
+        header: r2r::std_msgs::msg::Header { frame_id: "laser".into(), ..Default::default() },
+        angle_min: -std::f32::consts::PI,
+        angle_max: std::f32::consts::PI,
+        angle_increment: std::f32::consts::TAU / 360.0,
+        range_min: 0.05,
+        range_max: 8.0,
+        ranges: vec![8.5; 360],
+        ..Default::default()
+    };
     let n = config.layout.num_cells();
     let cells = SkinCellArray {
         cell_id: config.layout.cells().iter().map(|c| c.id).collect(),
@@ -78,7 +88,9 @@ fn main() -> Result<()> {
 
     // wait until the controller listens to every input
     let start = Instant::now();
-    while [joints_pub.get_inter_process_subscription_count()?, cells_pub.get_inter_process_subscription_count()?].contains(&0) {
+    while [joints_pub.get_inter_process_subscription_count()?, cells_pub.get_inter_process_subscription_count()?]
+        .contains(&0)
+    {
         node.spin_once(Duration::from_millis(20));
         if start.elapsed() > Duration::from_secs(30) {
             bail!("no task_controller subscribed to /joint_states and /skin/cells within 30 s");

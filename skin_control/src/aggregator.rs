@@ -1,5 +1,5 @@
 //! The skin aggregator's work, without the node around it: cells in, patch wrenches and markers
-//! out (paper 003 eq. 6-8 through `skin_core::skin::aggregate`).
+//! out (interactive-force-control paper eq. 6-8 through `skin_core::skin::aggregate`).
 use r2r::builtin_interfaces::msg::Time;
 use r2r::skin_msgs::msg::PatchWrenchArray;
 use r2r::visualization_msgs::msg::MarkerArray;
@@ -13,17 +13,23 @@ use crate::markers::SkinMarkers;
 /// `ros2 param describe` texts of the skin model parameters (`skin_core::skin::params::SkinParams`,
 /// `config/skin_model.yaml`), by dotted key.
 pub const SKIN_PARAM_DESCRIPTIONS: &[(&str, &str)] = &[
-    ("proximity.range_m", "Proximity sensing range [m]: signal 0 from here on (paper 000 eq. 3 d_range)"),
+    ("proximity.range_m", "Proximity sensing range [m]: signal 0 from here on (intentional-contact paper eq. 3 d_range)"),
     ("proximity.decay_m", "Decay length of the proximity characteristic p(d) [m]"),
     ("force.scale_n", "Scale of the force characteristic f(F) [N]"),
     ("force.max_n", "Force at which the force signal saturates at 1 [N]"),
-    ("fusion.weight_force", "w of paper 003 eq. 6 in [0, 1]: cell virtual force sF = w f + (1 - w) p (0: proximity only, 1: force only)"),
-    ("fusion.activity_threshold", "A cell is active (enters the patch wrench, eq. 7-8) when sF exceeds this, in [0, 1)"),
+    (
+        "fusion.weight_force",
+        "w of interactive-force-control paper eq. 6 in [0, 1]: cell virtual force sF = w f + (1 - w) p (0: proximity only, 1: force only)",
+    ),
+    (
+        "fusion.activity_threshold",
+        "A cell is active (enters the patch wrench, eq. 7-8) when sF exceeds this, in [0, 1)",
+    ),
     ("fusion.force_reduction", "How a cell's three force sensors make one signal: mean | max"),
-    ("repulsion.gain_n_per_m", "Paper 000 eq. 3 repulsion gain K [N/m]"),
-    ("repulsion.range_m", "Paper 000 eq. 3 repulsion range [m], <= proximity.range_m"),
-    ("repulsion.max_force_n", "Paper 003 eq. 16 largest repulsive force [N]"),
-    ("repulsion.decay_m", "Paper 003 eq. 16 decay length [m]"),
+    ("repulsion.gain_n_per_m", "Intentional-contact paper eq. 3 repulsion gain K [N/m]"),
+    ("repulsion.range_m", "Intentional-contact paper eq. 3 repulsion range [m], <= proximity.range_m"),
+    ("repulsion.max_force_n", "Interactive-force-control paper eq. 16 largest repulsive force [N]"),
+    ("repulsion.decay_m", "Interactive-force-control paper eq. 16 decay length [m]"),
 ];
 
 /// Cells to patch wrenches and markers for one layout; every buffer is kept between messages.
@@ -100,14 +106,7 @@ impl Aggregator {
             .expect("the cell buffer has one reading per layout cell");
         let stamp = &self.stamp;
         write_patch_array(&self.layout, &self.wrenches, stamp, &mut self.patches_msg);
-        self.markers.update(
-            &self.layout,
-            readings,
-            fusion,
-            &self.wrenches,
-            stamp,
-            &mut self.markers_msg,
-        );
+        self.markers.update(&self.layout, readings, fusion, &self.wrenches, stamp, &mut self.markers_msg);
         (&self.patches_msg, &self.markers_msg)
     }
 }
@@ -131,10 +130,7 @@ mod tests {
     fn every_skin_parameter_has_a_description() {
         let p = SkinParams::load(&repo("config/skin_model.yaml")).unwrap();
         let keys: Vec<String> = flatten(&p).unwrap().keys().cloned().collect();
-        let mut described: Vec<String> = SKIN_PARAM_DESCRIPTIONS
-            .iter()
-            .map(|(k, _)| k.to_string())
-            .collect();
+        let mut described: Vec<String> = SKIN_PARAM_DESCRIPTIONS.iter().map(|(k, _)| k.to_string()).collect();
         described.sort();
         assert_eq!(keys, described);
     }
@@ -142,16 +138,12 @@ mod tests {
     #[test]
     fn tomm_cells_to_patches() {
         let model = RobotModel::from_urdf_file(&repo("urdf/tomm.urdf")).unwrap();
-        let layout = SkinLayout::load(&repo("config/skin/tomm.yaml"))
-            .unwrap()
-            .resolve(&model)
-            .unwrap();
-        let fusion = SkinParams::load(&repo("config/skin_model.yaml"))
-            .unwrap()
-            .fusion;
+        let layout = SkinLayout::load(&repo("config/skin/tomm.yaml")).unwrap().resolve(&model).unwrap();
+        let fusion = SkinParams::load(&repo("config/skin_model.yaml")).unwrap().fusion;
         let first = layout.cells()[0].id;
         let mut agg = Aggregator::new(layout);
-        let msg = SkinCellArray { cell_id: vec![first], force: vec![0.5; 3], proximity: vec![0.5], ..Default::default() };
+        let msg =
+            SkinCellArray { cell_id: vec![first], force: vec![0.5; 3], proximity: vec![0.5], ..Default::default() };
         let bytes = |m: &SkinCellArray| m.to_serialized_bytes().unwrap();
         let (patches, markers) = agg.process(&bytes(&msg), &fusion, |i| panic!("{i}")).unwrap();
         assert_eq!(patches.patches.len(), 12);

@@ -159,7 +159,11 @@ mod tests {
         assert_eq!(pass(&mut gate, 10.2, Some(10.1)), Err(StampIssue::Future));
         assert_eq!(pass(&mut gate, 10.11, Some(10.11)), Ok(()), "the refused future stamp holds nothing back");
         assert_eq!(pass(&mut gate, 10.2, None), Ok(()), "no clock: only the order");
-        assert_eq!(pass(&mut gate, 10.1, None), Err(StampIssue::OutOfOrder), "the refused stamps did not count, 10.2 did");
+        assert_eq!(
+            pass(&mut gate, 10.1, None),
+            Err(StampIssue::OutOfOrder),
+            "the refused stamps did not count, 10.2 did"
+        );
         // the clock went back by 5 s: 10.2 is now from the future and blocks no honest message
         assert_eq!(pass(&mut gate, 5.0, Some(5.0)), Ok(()));
         assert_eq!(gate.last(), Some(5.0));

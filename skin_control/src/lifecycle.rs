@@ -93,7 +93,11 @@ impl Lifecycle {
         let Some(t) = self.available().find(asked).copied() else {
             let what = if id == 0 { format!("`{label}`") } else { format!("id {id}") };
             let names: Vec<&str> = self.available().map(|t| t.label).collect();
-            return Err(format!("transition {what} is not available in state {} (available: {})", self.state.label(), names.join(", ")));
+            return Err(format!(
+                "transition {what} is not available in state {} (available: {})",
+                self.state.label(),
+                names.join(", ")
+            ));
         };
         self.state = t.to;
         Ok(t)
@@ -109,7 +113,10 @@ mod tests {
         let mut l = Lifecycle::default();
         assert_eq!(l.state(), State::Unconfigured);
         let e = l.change(0, "activate").unwrap_err();
-        assert!(e.contains("`activate` is not available in state unconfigured (available: configure, shutdown)"), "{e}");
+        assert!(
+            e.contains("`activate` is not available in state unconfigured (available: configure, shutdown)"),
+            "{e}"
+        );
         assert_eq!(l.change(1, "").unwrap().to, State::Inactive);
         assert_eq!(l.change(0, "activate").unwrap().id, 3);
         assert_eq!(l.state(), State::Active);

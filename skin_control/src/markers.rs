@@ -54,11 +54,7 @@ fn color([r, g, b, a]: Rgba) -> ColorRGBA {
 
 /// The message of one marker update, stamped `stamp` (a delete-all is not stamped).
 fn marker(m: &SkinMarker, stamp: &Time) -> Marker {
-    let mut out = Marker {
-        ns: m.ns.to_string(),
-        id: m.id,
-        ..Default::default()
-    };
+    let mut out = Marker { ns: m.ns.to_string(), id: m.id, ..Default::default() };
     out.action = match m.action {
         MarkerAction::DeleteAll => return Marker { action: Marker::DELETEALL as i32, ..Default::default() },
         MarkerAction::Delete => Marker::DELETE as i32,
@@ -88,19 +84,13 @@ mod tests {
     use skin_core::skin::markers::cell_color;
     use skin_core::skin::signals::ForceReduction;
 
-    const FUSION: FusionParams = FusionParams {
-        weight_force: 0.5,
-        activity_threshold: 0.02,
-        force_reduction: ForceReduction::Mean,
-    };
+    const FUSION: FusionParams =
+        FusionParams { weight_force: 0.5, activity_threshold: 0.02, force_reduction: ForceReduction::Mean };
 
     fn layout() -> ResolvedLayout {
         let text = "patches:\n  - {id: 7, link: a, xyz: [0, 0, 1]}\ncells:\n  \
                     - {id: 10, patch: 7, position: [0.1, 0, 0], normal: [1, 0, 0]}\n";
-        SkinLayout::from_yaml_str(text, "t.yaml")
-            .unwrap()
-            .resolve_with(|_| Some(1))
-            .unwrap()
+        SkinLayout::from_yaml_str(text, "t.yaml").unwrap().resolve_with(|_| Some(1)).unwrap()
     }
 
     fn run(m: &mut SkinMarkers, l: &ResolvedLayout, r: &[CellReading], stamp: &Time) -> MarkerArray {
@@ -120,7 +110,10 @@ mod tests {
         let actions: Vec<i32> = out.markers.iter().map(|m| m.action).collect();
         assert_eq!(actions, [Marker::DELETEALL as i32, Marker::ADD as i32, Marker::ADD as i32]);
         let (cells, arrow) = (&out.markers[1], &out.markers[2]);
-        assert_eq!((cells.ns.as_str(), cells.type_, cells.header.frame_id.as_str()), (CELLS_NS, Marker::SPHERE_LIST as i32, "a"));
+        assert_eq!(
+            (cells.ns.as_str(), cells.type_, cells.header.frame_id.as_str()),
+            (CELLS_NS, Marker::SPHERE_LIST as i32, "a")
+        );
         assert_eq!(cells.header.stamp, stamp);
         assert_eq!((cells.points[0].x, cells.points[0].z), (0.1, 1.0));
         assert_eq!(cells.colors[0], color(cell_color(0.8, 0.4)));

@@ -13,11 +13,7 @@ pub fn search_dirs() -> Vec<PathBuf> {
         dirs.extend(std::env::split_paths(&prefixes).map(|p| p.join("share").join(PACKAGE)));
     }
     // The crate sits one level below the repository root.
-    dirs.extend(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .parent()
-            .map(Path::to_path_buf),
-    );
+    dirs.extend(Path::new(env!("CARGO_MANIFEST_DIR")).parent().map(Path::to_path_buf));
     dirs
 }
 
@@ -25,19 +21,12 @@ pub fn search_dirs() -> Vec<PathBuf> {
 /// The error lists every place tried.
 pub fn resolve_in(path: &str, dirs: &[PathBuf]) -> Result<PathBuf, String> {
     let p = Path::new(path);
-    let candidates: Vec<PathBuf> = if p.is_absolute() {
-        vec![p.to_path_buf()]
-    } else {
-        dirs.iter().map(|d| d.join(p)).collect()
-    };
-    candidates
-        .iter()
-        .find(|c| c.is_file())
-        .cloned()
-        .ok_or_else(|| {
-            let tried: Vec<String> = candidates.iter().map(|c| c.display().to_string()).collect();
-            format!("`{path}` not found (tried {})", tried.join(", "))
-        })
+    let candidates: Vec<PathBuf> =
+        if p.is_absolute() { vec![p.to_path_buf()] } else { dirs.iter().map(|d| d.join(p)).collect() };
+    candidates.iter().find(|c| c.is_file()).cloned().ok_or_else(|| {
+        let tried: Vec<String> = candidates.iter().map(|c| c.display().to_string()).collect();
+        format!("`{path}` not found (tried {})", tried.join(", "))
+    })
 }
 
 /// [`resolve_in`] the [`search_dirs`].
@@ -54,10 +43,7 @@ mod tests {
         let p = resolve("config/skin_model.yaml").unwrap();
         assert!(p.is_file());
         let e = resolve_in("nope.yaml", &[PathBuf::from("/a"), PathBuf::from("/b")]).unwrap_err();
-        assert_eq!(
-            e,
-            "`nope.yaml` not found (tried /a/nope.yaml, /b/nope.yaml)"
-        );
+        assert_eq!(e, "`nope.yaml` not found (tried /a/nope.yaml, /b/nope.yaml)");
         let e = resolve_in("/abs/nope.yaml", &[PathBuf::from("/a")]).unwrap_err();
         assert_eq!(e, "`/abs/nope.yaml` not found (tried /abs/nope.yaml)");
     }

@@ -33,10 +33,7 @@ pub struct ParamError {
 
 impl ParamError {
     fn new(key: &str, reason: impl Into<String>) -> Self {
-        ParamError {
-            key: key.to_string(),
-            reason: reason.into(),
-        }
+        ParamError { key: key.to_string(), reason: reason.into() }
     }
 }
 
@@ -56,10 +53,7 @@ impl From<ParamError> for r2r::Error {
     fn from(e: ParamError) -> Self {
         // The variant r2r shows with a free-form message (the reason goes back to the caller of
         // set_parameters as is).
-        r2r::Error::ParameterValueConv {
-            name: e.key,
-            msg: e.reason,
-        }
+        r2r::Error::ParameterValueConv { name: e.key, msg: e.reason }
     }
 }
 
@@ -99,14 +93,8 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
     }
 
     /// Adds a read-only entry `name` (listed and readable; set requests are rejected).
-    pub fn with_read_only(
-        mut self,
-        name: &str,
-        value: ParameterValue,
-        description: &'static str,
-    ) -> Self {
-        self.read_only
-            .insert(name.to_string(), (value, description));
+    pub fn with_read_only(mut self, name: &str, value: ParameterValue, description: &'static str) -> Self {
+        self.read_only.insert(name.to_string(), (value, description));
         self
     }
 
@@ -118,9 +106,7 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
     }
 
     fn is_start_only(&self, key: &str) -> bool {
-        self.start_only
-            .iter()
-            .any(|k| key == *k || (k.ends_with('.') && key.starts_with(k)))
+        self.start_only.iter().any(|k| key == *k || (k.ends_with('.') && key.starts_with(k)))
     }
 
     /// The current, valid struct.
@@ -136,21 +122,12 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
     /// The struct with `key` set to `value`, validated; `self` is unchanged.
     pub fn with_value(&self, key: &str, value: &ParameterValue) -> Result<T, ParamError> {
         if self.read_only.contains_key(key) {
-            return Err(ParamError::new(
-                key,
-                "read-only: read at start, restart the node to change it",
-            ));
+            return Err(ParamError::new(key, "read-only: read at start, restart the node to change it"));
         }
         if self.is_start_only(key) {
-            return Err(ParamError::new(
-                key,
-                "read-only: read at start, restart the node to change it",
-            ));
+            return Err(ParamError::new(key, "read-only: read at start, restart the node to change it"));
         }
-        let current = self
-            .flat
-            .get(key)
-            .ok_or_else(|| ParamError::new(key, "no such parameter"))?;
+        let current = self.flat.get(key).ok_or_else(|| ParamError::new(key, "no such parameter"))?;
         let mut flat = self.flat.clone();
         flat.insert(key.to_string(), coerce(key, current, value)?);
         let candidate: T = unflatten(&flat).map_err(|reason| ParamError::new(key, reason))?;
@@ -167,27 +144,18 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
     }
 
     fn description(&self, key: &str) -> &'static str {
-        self.descriptions
-            .iter()
-            .find(|(k, _)| *k == key)
-            .map_or("", |(_, d)| d)
+        self.descriptions.iter().find(|(k, _)| *k == key).map_or("", |(_, d)| d)
     }
 
     /// Lays the node's parameter overrides (name -> value, as r2r reads them from `--ros-args`)
     /// over the current value, all at once, then validates; an unknown name is an error.
-    pub fn apply_overrides(
-        &mut self,
-        overrides: &IndexMap<String, Parameter>,
-    ) -> Result<(), ParamError> {
+    pub fn apply_overrides(&mut self, overrides: &IndexMap<String, Parameter>) -> Result<(), ParamError> {
         let mut flat = self.flat.clone();
         for (key, p) in overrides {
             if let Some(current) = flat.get_mut(key) {
                 *current = coerce(key, current, &p.value)?;
             } else if !self.read_only.contains_key(key) && !UNDECLARED_OK.contains(&key.as_str()) {
-                return Err(ParamError::new(
-                    key,
-                    "unknown parameter (a typo in the parameter file?)",
-                ));
+                return Err(ParamError::new(key, "unknown parameter (a typo in the parameter file?)"));
             }
         }
         let value: T = unflatten(&flat).map_err(|reason| ParamError::new("", reason))?;
@@ -202,22 +170,10 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
         self.apply_overrides(params)?;
         for (key, v) in &self.flat {
             let description = self.description(key);
-            params.insert(
-                key.clone(),
-                Parameter {
-                    value: v.clone(),
-                    description,
-                },
-            );
+            params.insert(key.clone(), Parameter { value: v.clone(), description });
         }
         for (key, (v, description)) in &self.read_only {
-            params.insert(
-                key.clone(),
-                Parameter {
-                    value: v.clone(),
-                    description,
-                },
-            );
+            params.insert(key.clone(), Parameter { value: v.clone(), description });
         }
         Ok(())
     }
@@ -231,9 +187,7 @@ impl<T: Serialize + DeserializeOwned> RosParams for StructParams<T> {
         params: &mut IndexMap<String, Parameter>,
     ) -> r2r::Result<()> {
         if !prefix.is_empty() {
-            return Err(
-                ParamError::new(prefix, "StructParams serves the node's top level only").into(),
-            );
+            return Err(ParamError::new(prefix, "StructParams serves the node's top level only").into());
         }
         Ok(self.register(params)?)
     }
@@ -256,23 +210,14 @@ impl<T: Serialize + DeserializeOwned> RosParams for StructParams<T> {
 }
 
 /// `value` as a parameter of the type of `current` (an integer may set a double).
-fn coerce(
-    key: &str,
-    current: &ParameterValue,
-    value: &ParameterValue,
-) -> Result<ParameterValue, ParamError> {
+fn coerce(key: &str, current: &ParameterValue, value: &ParameterValue) -> Result<ParameterValue, ParamError> {
     use ParameterValue as P;
     match (current, value) {
         (P::Double(_), P::Integer(i)) => Ok(P::Double(*i as f64)),
-        (P::DoubleArray(_), P::IntegerArray(a)) => {
-            Ok(P::DoubleArray(a.iter().map(|&i| i as f64).collect()))
-        }
+        (P::DoubleArray(_), P::IntegerArray(a)) => Ok(P::DoubleArray(a.iter().map(|&i| i as f64).collect())),
         (P::NotSet, v) => Ok(v.clone()),
         (c, v) if std::mem::discriminant(c) == std::mem::discriminant(v) => Ok(v.clone()),
-        (c, v) => Err(ParamError::new(
-            key,
-            format!("expected type {}, got {}", c.type_name(), v.type_name()),
-        )),
+        (c, v) => Err(ParamError::new(key, format!("expected type {}, got {}", c.type_name(), v.type_name()))),
     }
 }
 
@@ -284,18 +229,10 @@ pub fn flatten<T: Serialize>(value: &T) -> Result<IndexMap<String, ParameterValu
     Ok(out)
 }
 
-fn flatten_into(
-    key: &str,
-    v: &Value,
-    out: &mut IndexMap<String, ParameterValue>,
-) -> Result<(), ParamError> {
+fn flatten_into(key: &str, v: &Value, out: &mut IndexMap<String, ParameterValue>) -> Result<(), ParamError> {
     if let Value::Object(map) = v {
         for (name, child) in map {
-            let child_key = if key.is_empty() {
-                name.clone()
-            } else {
-                format!("{key}.{name}")
-            };
+            let child_key = if key.is_empty() { name.clone() } else { format!("{key}.{name}") };
             flatten_into(&child_key, child, out)?;
         }
     } else {
@@ -312,25 +249,14 @@ fn leaf(key: &str, v: &Value) -> Result<ParameterValue, ParamError> {
         Value::Bool(b) => P::Bool(*b),
         Value::Number(n) => number(key, n)?,
         Value::String(s) => P::String(s.clone()),
-        Value::Array(a) if all(Value::is_boolean, a) => {
-            P::BoolArray(a.iter().filter_map(Value::as_bool).collect())
+        Value::Array(a) if all(Value::is_boolean, a) => P::BoolArray(a.iter().filter_map(Value::as_bool).collect()),
+        Value::Array(a) if all(Value::is_i64, a) => P::IntegerArray(a.iter().filter_map(Value::as_i64).collect()),
+        Value::Array(a) if all(Value::is_number, a) => P::DoubleArray(a.iter().filter_map(Value::as_f64).collect()),
+        Value::Array(a) if all(Value::is_string, a) => {
+            P::StringArray(a.iter().filter_map(|s| s.as_str().map(str::to_string)).collect())
         }
-        Value::Array(a) if all(Value::is_i64, a) => {
-            P::IntegerArray(a.iter().filter_map(Value::as_i64).collect())
-        }
-        Value::Array(a) if all(Value::is_number, a) => {
-            P::DoubleArray(a.iter().filter_map(Value::as_f64).collect())
-        }
-        Value::Array(a) if all(Value::is_string, a) => P::StringArray(
-            a.iter()
-                .filter_map(|s| s.as_str().map(str::to_string))
-                .collect(),
-        ),
         Value::Array(_) | Value::Object(_) => {
-            return Err(ParamError::new(
-                key,
-                "not a ROS parameter type (empty, mixed or nested array)",
-            ))
+            return Err(ParamError::new(key, "not a ROS parameter type (empty, mixed or nested array)"))
         }
     })
 }
@@ -341,17 +267,12 @@ fn number(key: &str, n: &Number) -> Result<ParameterValue, ParamError> {
     } else if n.is_f64() {
         Ok(ParameterValue::Double(n.as_f64().unwrap_or(f64::NAN)))
     } else {
-        Err(ParamError::new(
-            key,
-            "integer beyond the range of a ROS integer parameter",
-        ))
+        Err(ParamError::new(key, "integer beyond the range of a ROS integer parameter"))
     }
 }
 
 /// Rebuilds `T` from dotted keys (the inverse of [`flatten`]); the error is serde's reason.
-pub fn unflatten<T: DeserializeOwned>(
-    flat: &IndexMap<String, ParameterValue>,
-) -> Result<T, String> {
+pub fn unflatten<T: DeserializeOwned>(flat: &IndexMap<String, ParameterValue>) -> Result<T, String> {
     let mut root = Map::new();
     for (key, v) in flat {
         let mut node = &mut root;
@@ -360,12 +281,8 @@ pub fn unflatten<T: DeserializeOwned>(
             if parts.peek().is_none() {
                 node.insert(part.to_string(), to_json(key, v)?);
             } else {
-                let child = node
-                    .entry(part.to_string())
-                    .or_insert_with(|| Value::Object(Map::new()));
-                node = child
-                    .as_object_mut()
-                    .ok_or_else(|| format!("`{key}`: `{part}` is a value and a section"))?;
+                let child = node.entry(part.to_string()).or_insert_with(|| Value::Object(Map::new()));
+                node = child.as_object_mut().ok_or_else(|| format!("`{key}`: `{part}` is a value and a section"))?;
             }
         }
     }
@@ -374,11 +291,8 @@ pub fn unflatten<T: DeserializeOwned>(
 
 fn to_json(key: &str, v: &ParameterValue) -> Result<Value, String> {
     use ParameterValue as P;
-    let double = |x: f64| {
-        Number::from_f64(x)
-            .map(Value::Number)
-            .ok_or_else(|| format!("`{key}` = {x}: not a finite number"))
-    };
+    let double =
+        |x: f64| Number::from_f64(x).map(Value::Number).ok_or_else(|| format!("`{key}` = {x}: not a finite number"));
     Ok(match v {
         P::NotSet => Value::Null,
         P::Bool(b) => Value::Bool(*b),
@@ -401,22 +315,13 @@ mod tests {
     use std::path::Path;
 
     fn skin_params() -> SkinParams {
-        SkinParams::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/skin_model.yaml"))
-            .unwrap()
+        SkinParams::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/skin_model.yaml")).unwrap()
     }
 
     fn served() -> StructParams<SkinParams> {
-        StructParams::new(
-            skin_params(),
-            |p| p.validate().map_err(|e| e.to_string()),
-            &[("fusion.weight_force", "w")],
-        )
-        .unwrap()
-        .with_read_only(
-            "layout_file",
-            ParameterValue::String("l.yaml".into()),
-            "layout",
-        )
+        StructParams::new(skin_params(), |p| p.validate().map_err(|e| e.to_string()), &[("fusion.weight_force", "w")])
+            .unwrap()
+            .with_read_only("layout_file", ParameterValue::String("l.yaml".into()), "layout")
     }
 
     #[test]
@@ -424,67 +329,34 @@ mod tests {
         let p = skin_params();
         let flat = flatten(&p).unwrap();
         assert_eq!(flat["fusion.weight_force"], ParameterValue::Double(0.5));
-        assert_eq!(
-            flat["fusion.force_reduction"],
-            ParameterValue::String("mean".into())
-        );
+        assert_eq!(flat["fusion.force_reduction"], ParameterValue::String("mean".into()));
         assert_eq!(unflatten::<SkinParams>(&flat).unwrap(), p);
     }
 
     #[test]
     fn set_applies_valid_values_and_rejects_invalid_ones_with_the_reason() {
         let mut s = served();
-        s.set("fusion.weight_force", &ParameterValue::Double(0.25))
-            .unwrap();
+        s.set("fusion.weight_force", &ParameterValue::Double(0.25)).unwrap();
         assert_eq!(s.value().fusion.weight_force, 0.25);
-        s.set("fusion.weight_force", &ParameterValue::Integer(1))
-            .unwrap();
+        s.set("fusion.weight_force", &ParameterValue::Integer(1)).unwrap();
         assert_eq!(s.value().fusion.weight_force, 1.0);
-        let e = s
-            .set("fusion.weight_force", &ParameterValue::Double(1.5))
-            .unwrap_err();
+        let e = s.set("fusion.weight_force", &ParameterValue::Double(1.5)).unwrap_err();
         assert_eq!(e.key, "fusion.weight_force");
-        assert!(
-            e.reason.contains("fusion.weight_force") && e.reason.contains("[0, 1]"),
-            "{e}"
-        );
-        assert_eq!(
-            s.value().fusion.weight_force,
-            1.0,
-            "unchanged after a rejection"
-        );
-        let e = s
-            .set(
-                "fusion.force_reduction",
-                &ParameterValue::String("median".into()),
-            )
-            .unwrap_err();
+        assert!(e.reason.contains("fusion.weight_force") && e.reason.contains("[0, 1]"), "{e}");
+        assert_eq!(s.value().fusion.weight_force, 1.0, "unchanged after a rejection");
+        let e = s.set("fusion.force_reduction", &ParameterValue::String("median".into())).unwrap_err();
         assert!(e.reason.contains("unknown variant `median`"), "{e}");
-        s.set(
-            "fusion.force_reduction",
-            &ParameterValue::String("max".into()),
-        )
-        .unwrap();
-        let e = s
-            .set("fusion.weight_force", &ParameterValue::String("x".into()))
-            .unwrap_err();
+        s.set("fusion.force_reduction", &ParameterValue::String("max".into())).unwrap();
+        let e = s.set("fusion.weight_force", &ParameterValue::String("x".into())).unwrap_err();
         assert_eq!(e.reason, "expected type double, got string");
         // A cross-field rule of SkinParams::validate names the other key.
-        let e = s
-            .set("proximity.range_m", &ParameterValue::Double(0.05))
-            .unwrap_err();
+        let e = s.set("proximity.range_m", &ParameterValue::Double(0.05)).unwrap_err();
         assert!(e.reason.contains("repulsion.range_m"), "{e}");
-        let e = s
-            .set("layout_file", &ParameterValue::String("x".into()))
-            .unwrap_err();
+        let e = s.set("layout_file", &ParameterValue::String("x".into())).unwrap_err();
         assert!(e.reason.starts_with("read-only"), "{e}");
-        let e = s
-            .set("fusion.bogus", &ParameterValue::Double(0.0))
-            .unwrap_err();
+        let e = s.set("fusion.bogus", &ParameterValue::Double(0.0)).unwrap_err();
         assert_eq!(e.to_string(), "parameter `fusion.bogus`: no such parameter");
-        let e = s
-            .set("fusion.weight_force", &ParameterValue::Double(f64::NAN))
-            .unwrap_err();
+        let e = s.set("fusion.weight_force", &ParameterValue::Double(f64::NAN)).unwrap_err();
         assert!(e.reason.contains("not a finite number"), "{e}");
     }
 
@@ -492,59 +364,27 @@ mod tests {
     fn register_overlays_overrides_declares_everything_and_rejects_unknown_keys() {
         let mut s = served();
         let mut params = IndexMap::new();
-        params.insert(
-            "fusion.weight_force".to_string(),
-            Parameter::new(ParameterValue::Double(0.75)),
-        );
-        params.insert(
-            "use_sim_time".to_string(),
-            Parameter::new(ParameterValue::Bool(false)),
-        );
+        params.insert("fusion.weight_force".to_string(), Parameter::new(ParameterValue::Double(0.75)));
+        params.insert("use_sim_time".to_string(), Parameter::new(ParameterValue::Bool(false)));
         s.register_parameters("", None, &mut params).unwrap();
         assert_eq!(s.value().fusion.weight_force, 0.75);
-        assert_eq!(
-            params["fusion.weight_force"].value,
-            ParameterValue::Double(0.75)
-        );
+        assert_eq!(params["fusion.weight_force"].value, ParameterValue::Double(0.75));
         assert_eq!(params["fusion.weight_force"].description, "w");
-        assert_eq!(
-            params["layout_file"].value,
-            ParameterValue::String("l.yaml".into())
-        );
+        assert_eq!(params["layout_file"].value, ParameterValue::String("l.yaml".into()));
         assert_eq!(params.len(), s.flat().len() + 2);
-        assert_eq!(
-            s.get_parameter("layout_file").unwrap(),
-            ParameterValue::String("l.yaml".into())
-        );
-        assert!(s
-            .check_parameter("fusion.weight_force", &ParameterValue::Double(2.0))
-            .is_err());
+        assert_eq!(s.get_parameter("layout_file").unwrap(), ParameterValue::String("l.yaml".into()));
+        assert!(s.check_parameter("fusion.weight_force", &ParameterValue::Double(2.0)).is_err());
 
         let mut s = served();
         let mut params = IndexMap::new();
-        params.insert(
-            "fusion.weight_forc".to_string(),
-            Parameter::new(ParameterValue::Double(0.75)),
-        );
-        let e = s
-            .register_parameters("", None, &mut params)
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("fusion.weight_forc") && e.contains("unknown parameter"),
-            "{e}"
-        );
+        params.insert("fusion.weight_forc".to_string(), Parameter::new(ParameterValue::Double(0.75)));
+        let e = s.register_parameters("", None, &mut params).unwrap_err().to_string();
+        assert!(e.contains("fusion.weight_forc") && e.contains("unknown parameter"), "{e}");
 
         let mut s = served();
         let mut params = IndexMap::new();
-        params.insert(
-            "fusion.activity_threshold".to_string(),
-            Parameter::new(ParameterValue::Double(1.0)),
-        );
-        let e = s
-            .register_parameters("", None, &mut params)
-            .unwrap_err()
-            .to_string();
+        params.insert("fusion.activity_threshold".to_string(), Parameter::new(ParameterValue::Double(1.0)));
+        let e = s.register_parameters("", None, &mut params).unwrap_err().to_string();
         assert!(e.contains("fusion.activity_threshold"), "{e}");
     }
 
@@ -578,27 +418,15 @@ mod tests {
         }
         let v = Outer {
             count: 3,
-            inner: Inner {
-                gains: [1.0, 2.5],
-                ids: vec![4, 5],
-                names: vec!["a".into()],
-                limit: None,
-            },
+            inner: Inner { gains: [1.0, 2.5], ids: vec![4, 5], names: vec!["a".into()], limit: None },
         };
         let mut s = StructParams::new(v, |_| Ok(()), &[]).unwrap();
         assert_eq!(s.flat()["count"], ParameterValue::Integer(3));
-        assert_eq!(
-            s.flat()["inner.ids"],
-            ParameterValue::IntegerArray(vec![4, 5])
-        );
+        assert_eq!(s.flat()["inner.ids"], ParameterValue::IntegerArray(vec![4, 5]));
         // serde_json writes 1.0 as a float: the array stays a double array.
-        assert_eq!(
-            s.flat()["inner.gains"],
-            ParameterValue::DoubleArray(vec![1.0, 2.5])
-        );
+        assert_eq!(s.flat()["inner.gains"], ParameterValue::DoubleArray(vec![1.0, 2.5]));
         assert_eq!(s.flat()["inner.limit"], ParameterValue::NotSet);
-        s.set("inner.gains", &ParameterValue::IntegerArray(vec![3, 4]))
-            .unwrap();
+        s.set("inner.gains", &ParameterValue::IntegerArray(vec![3, 4])).unwrap();
         assert_eq!(s.value().inner.gains, [3.0, 4.0]);
         s.set("inner.limit", &ParameterValue::Double(0.5)).unwrap();
         assert_eq!(s.value().inner.limit, Some(0.5));

@@ -90,12 +90,20 @@ mod tests {
 
     fn params(policy: &str) -> SupervisorParams {
         let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/supervisor.yaml");
-        let text = std::fs::read_to_string(p).unwrap().replace("policy: intentional_contact", &format!("policy: {policy}"));
+        let text =
+            std::fs::read_to_string(p).unwrap().replace("policy: intentional_contact", &format!("policy: {policy}"));
         SupervisorParams::from_yaml_str(&text, "supervisor.yaml").unwrap()
     }
 
     fn state(t: f64, speed: f64, fd: f64, fc: f64, ge: f64) -> ControllerState {
-        ControllerState { header: r2r::std_msgs::msg::Header { stamp: time_msg(t), ..Default::default() }, ee_speed: speed, avoidance_force: fd, contact_force: fc, goal_error: ge, ..Default::default() }
+        ControllerState {
+            header: r2r::std_msgs::msg::Header { stamp: time_msg(t), ..Default::default() },
+            ee_speed: speed,
+            avoidance_force: fd,
+            contact_force: fc,
+            goal_error: ge,
+            ..Default::default()
+        }
     }
 
     #[test]
@@ -104,7 +112,8 @@ mod tests {
         let first = s.on_state(&state(0.01, 0.5, 0.0, 0.0, 0.3)).unwrap();
         assert_eq!((first.mode, first.task_order[0].as_str()), (0, "avoidance"));
         assert!(s.on_state(&state(0.02, 0.5, 0.0, 0.0, 0.3)).is_none());
-        let stale = ControllerState { input_status: ControllerState::INPUT_STALE as u8, ..state(0.025, 0.5, 0.0, 9.0, 0.3) };
+        let stale =
+            ControllerState { input_status: ControllerState::INPUT_STALE as u8, ..state(0.025, 0.5, 0.0, 9.0, 0.3) };
         assert!(s.on_state(&stale).is_none() && s.updates() == 2, "a stale period's state is not an input");
         let hard = s.on_state(&state(0.03, 0.5, 0.0, 6.0, 0.3)).unwrap();
         assert_eq!(hard.mode, 2);

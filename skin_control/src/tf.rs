@@ -121,12 +121,19 @@ mod tests {
 
     #[test]
     fn transforms_become_stamped_messages() {
-        let pose = Isometry3::from_parts(Translation3::new(1.0, 2.0, 0.0), UnitQuaternion::from_euler_angles(0.0, 0.0, 0.5));
+        let pose =
+            Isometry3::from_parts(Translation3::new(1.0, 2.0, 0.0), UnitQuaternion::from_euler_angles(0.0, 0.0, 0.5));
         let t = FrameTransform { parent: "odom".into(), child: "base_link".into(), pose };
         let m = imp::message(&[t], &Time { sec: 3, nanosec: 4 });
         let ts = &m.transforms[0];
-        assert_eq!((ts.header.frame_id.as_str(), ts.child_frame_id.as_str(), ts.header.stamp.sec), ("odom", "base_link", 3));
+        assert_eq!(
+            (ts.header.frame_id.as_str(), ts.child_frame_id.as_str(), ts.header.stamp.sec),
+            ("odom", "base_link", 3)
+        );
         assert_eq!((ts.transform.translation.x, ts.transform.translation.y), (1.0, 2.0));
-        assert!((ts.transform.rotation.z - 0.25f64.sin()).abs() < 1e-15 && (ts.transform.rotation.w - 0.25f64.cos()).abs() < 1e-15);
+        assert!(
+            (ts.transform.rotation.z - 0.25f64.sin()).abs() < 1e-15
+                && (ts.transform.rotation.w - 0.25f64.cos()).abs() < 1e-15
+        );
     }
 }

@@ -5,7 +5,7 @@
 //! - `controller_update_tomm`: TOMM (15 DoF), 718 cells aggregated, four task levels (skin
 //!   avoidance with 12 cells in range, hand distance, wrist, tactile guidance) plus the posture
 //!   torque with body compliance and base avoidance from a 360-point scan.
-//! - `controller_update_planar7`: planar7 (7 DoF), 405 cells, paper 000 Table I (a): avoidance
+//! - `controller_update_planar7`: planar7 (7 DoF), 405 cells, intentional-contact paper Table I (a): avoidance
 //!   (8 cells in range) > goal > contact reaction (2 contact cells).
 
 use std::hint::black_box;
@@ -26,7 +26,14 @@ fn names(list: &[&str]) -> Vec<String> {
     list.iter().map(|s| s.to_string()).collect()
 }
 
-fn bench(c: &mut Criterion, id: &str, mut ctl: Controller, q: Vec<f64>, cells: Vec<CellReading>, scan: Vec<Vector2<f64>>) {
+fn bench(
+    c: &mut Criterion,
+    id: &str,
+    mut ctl: Controller,
+    q: Vec<f64>,
+    cells: Vec<CellReading>,
+    scan: Vec<Vector2<f64>>,
+) {
     let qd: Vec<f64> = (0..q.len()).map(|i| 0.02 * ((i as f64) * 0.7).sin()).collect();
     let mut t = 0.0;
     c.bench_function(id, |b| {
@@ -54,10 +61,12 @@ fn controller(c: &mut Criterion) {
             cells[i] = CellReading::uniform(0.3, 1.0); // touches on the forearm and the palm
         }
     }
-    let scan = (0..360).map(|k| {
-        let a = (k as f64).to_radians();
-        Vector2::new(a.cos(), a.sin()) * (0.6 + 0.2 * (3.0 * a).cos())
-    }).collect();
+    let scan = (0..360)
+        .map(|k| {
+            let a = (k as f64).to_radians();
+            Vector2::new(a.cos(), a.sin()) * (0.6 + 0.2 * (3.0 * a).cos())
+        })
+        .collect();
     let q = cfg.setup.posture.clone();
     let ctl = Controller::new(cfg, 0.0).unwrap();
     assert_eq!(ctl.arrangement().task_order().len(), 7);

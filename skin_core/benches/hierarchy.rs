@@ -34,21 +34,27 @@ fn fill(s: &mut Setup) {
     let hand = model.frame_index("right_hand").unwrap();
     let left = model.frame_index("left_hand").unwrap();
     let p0 = Vector3::zeros();
-    // 1: avoidance force along a skin cell's normal (paper 000 eq. 3-4)
+    // 1: avoidance force along a skin cell's normal (intentional-contact paper eq. 3-4)
     let cell = Vector3::new(-0.2, 0.0, 0.05);
     point_jacobian(model, &s.data, forearm, &cell, &mut s.j).unwrap();
     s.levels[0].clear();
     s.levels[0].push_directional(&[0.0, 0.6, 0.8], &s.j.fixed_rows::<3>(0), Reference::Force { f: &[4.0] }).unwrap();
-    // 2, 3: wrist orientation and hand position (paper 003 eq. 10, 12)
+    // 2, 3: wrist orientation and hand position (interactive-force-control paper eq. 10, 12)
     point_jacobian(model, &s.data, hand, &p0, &mut s.j).unwrap();
     point_jacobian_dot_qdot(model, &s.data, hand, &p0, &mut s.jd).unwrap();
     let (jd_ang, jd_lin) = ([s.jd[3], s.jd[4], s.jd[5]], [s.jd[0], s.jd[1], s.jd[2]]);
-    s.levels[1].set(&s.j.fixed_rows::<3>(3), Reference::Acceleration { xdd_star: &[0.1, -0.2, 0.05], jdot_qdot: &jd_ang }).unwrap();
-    s.levels[2].set(&s.j.fixed_rows::<3>(0), Reference::Acceleration { xdd_star: &[0.3, 0.0, -0.1], jdot_qdot: &jd_lin }).unwrap();
+    s.levels[1]
+        .set(&s.j.fixed_rows::<3>(3), Reference::Acceleration { xdd_star: &[0.1, -0.2, 0.05], jdot_qdot: &jd_ang })
+        .unwrap();
+    s.levels[2]
+        .set(&s.j.fixed_rows::<3>(0), Reference::Acceleration { xdd_star: &[0.3, 0.0, -0.1], jdot_qdot: &jd_lin })
+        .unwrap();
     // 4: full 6-D task on the left hand
     point_jacobian(model, &s.data, left, &p0, &mut s.j).unwrap();
     point_jacobian_dot_qdot(model, &s.data, left, &p0, &mut s.jd).unwrap();
-    s.levels[3].set(&s.j, Reference::Acceleration { xdd_star: &[0.0, 0.1, 0.0, 0.0, 0.0, 0.2], jdot_qdot: s.jd.as_slice() }).unwrap();
+    s.levels[3]
+        .set(&s.j, Reference::Acceleration { xdd_star: &[0.0, 0.1, 0.0, 0.0, 0.0, 0.2], jdot_qdot: s.jd.as_slice() })
+        .unwrap();
     for (i, t) in s.posture.iter_mut().enumerate() {
         *t = -2.0 * (s.q[i] - 0.1) - 0.5 * s.qd[i];
     }
@@ -85,7 +91,13 @@ fn hierarchy_tomm(c: &mut Criterion) {
     c.bench_function("hierarchy_tomm_4_levels", |b| {
         b.iter(|| {
             solver
-                .solve(black_box(&s.m), s.levels.iter(), Some(black_box(&s.posture[..])), Some(s.bias.as_slice()), &mut tau)
+                .solve(
+                    black_box(&s.m),
+                    s.levels.iter(),
+                    Some(black_box(&s.posture[..])),
+                    Some(s.bias.as_slice()),
+                    &mut tau,
+                )
                 .unwrap();
             black_box(&tau);
         })

@@ -25,13 +25,9 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             k = k.wrapping_add(1);
             tau[k % n] = if k % 2 == 0 { 40.0 } else { -40.0 };
-            let c = r
-                .update_arms(black_box(&tau), &g, &q, &qd, 1.0 / 125.0)
-                .unwrap();
+            let c = r.update_arms(black_box(&tau), &g, &q, &qd, 1.0 / 125.0).unwrap();
             black_box(c.joint_velocities[0]);
-            let c = r
-                .update_base(black_box(&tau), &q, &qd, 1.0 / 1000.0)
-                .unwrap();
+            let c = r.update_base(black_box(&tau), &q, &qd, 1.0 / 1000.0).unwrap();
             black_box(c.base_twist);
         })
     });

@@ -1,6 +1,6 @@
-//! Cost of the priority supervisor per control cycle: `supervisor_update` runs one paper 000
+//! Cost of the priority supervisor per control cycle: `supervisor_update` runs one intentional-contact paper
 //! Table I update (cycling through (a), (b), (c) so every branch is exercised), `blend_15dof`
-//! one paper 000 eq. (10) torque blend for TOMM's 15 DoF during a switch.
+//! one intentional-contact paper eq. (10) torque blend for TOMM's 15 DoF during a switch.
 
 use std::hint::black_box;
 

@@ -7,15 +7,15 @@
 //!   [`model::ModelData`] workspace that kinematics and dynamics (CRBA, RNEA) fill.
 //! - [`skin`]: skin layouts, the cells' signal characteristics and the aggregation of cells into
 //!   forces, patch wrenches and joint torques.
-//! - [`hierarchy`]: the multi-priority torque solver (paper 003 eq. 19-25, with paper 000's
+//! - [`hierarchy`]: the multi-priority torque solver (interactive-force-control paper eq. 19-25, with intentional-contact paper's
 //!   task-space force levels): ordered [`hierarchy::TaskLevel`]s and a posture torque in, joint
 //!   torque out, with damped, rank-aware inverses.
-//! - [`resolver`]: the admittance torque resolver (paper 003 eq. 26): torques to joint and base
+//! - [`resolver`]: the admittance torque resolver (interactive-force-control paper eq. 26): torques to joint and base
 //!   velocity commands within the limits.
-//! - [`tasks`]: the tasks of both papers filling the hierarchy's levels (paper 000 eq. 3-9,
-//!   paper 003 eq. 4-18).
-//! - [`supervisor`]: which arrangement of tasks is active (paper 000 Table I, paper 003 Table 1)
-//!   and the smooth switch between them (paper 000 eq. 10-11).
+//! - [`tasks`]: the tasks of both papers filling the hierarchy's levels (intentional-contact paper eq. 3-9,
+//!   interactive-force-control paper eq. 4-18).
+//! - [`supervisor`]: which arrangement of tasks is active (intentional-contact paper Table I, interactive-force-control paper Table 1)
+//!   and the smooth switch between them (intentional-contact paper eq. 10-11).
 #![warn(missing_docs)]
 
 /// Defines `pub(crate) fn $name` calling `$kernel` compiled for AVX2 when the CPU has it (4

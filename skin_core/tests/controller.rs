@@ -61,18 +61,29 @@ fn case(nv: usize, ncells: usize) -> impl Strategy<Value = Case> {
         ),
         (prop::option::of(0..20usize), prop::option::of(0..20usize), prop::option::of(0..20usize)),
     )
-        .prop_map(|(q_unit, qd, singular, cells, whole_patch, goal, scan, (nan_state_cycle, nan_dt_cycle, phase_switch_cycle))| Case {
-            q_unit,
-            qd,
-            singular,
-            cells,
-            whole_patch,
-            goal,
-            scan,
-            nan_state_cycle,
-            nan_dt_cycle,
-            phase_switch_cycle,
-        })
+        .prop_map(
+            |(
+                q_unit,
+                qd,
+                singular,
+                cells,
+                whole_patch,
+                goal,
+                scan,
+                (nan_state_cycle, nan_dt_cycle, phase_switch_cycle),
+            )| Case {
+                q_unit,
+                qd,
+                singular,
+                cells,
+                whole_patch,
+                goal,
+                scan,
+                nan_state_cycle,
+                nan_dt_cycle,
+                phase_switch_cycle,
+            },
+        )
 }
 
 /// Exactly singular configurations: planar7 stretched; TOMM with both UR5 elbows stretched and
@@ -102,10 +113,14 @@ fn run_case(robot: &str, policy: Policy, c: &Case) -> Result<(), TestCaseError> 
         singular_q(robot, nv)
     } else {
         let lim = model.joint_limits();
-        c.q_unit.iter().zip(lim).map(|(u, l)| {
-            let (lo, hi) = (l.lower.max(-3.0), l.upper.min(3.0));
-            lo + u * (hi - lo)
-        }).collect()
+        c.q_unit
+            .iter()
+            .zip(lim)
+            .map(|(u, l)| {
+                let (lo, hi) = (l.lower.max(-3.0), l.upper.min(3.0));
+                lo + u * (hi - lo)
+            })
+            .collect()
     };
     let vmax = ctl.resolver().arm_velocity_limits().to_vec();
     let arm = ctl.resolver().arm_joints().to_vec();
@@ -148,7 +163,11 @@ fn run_case(robot: &str, policy: Policy, c: &Case) -> Result<(), TestCaseError> 
             prop_assert!(v.is_finite(), "{robot}: joint {i} command {v} at cycle {k}");
             prop_assert!(v.abs() <= vmax[i] * (1.0 + 1e-12), "{robot}: joint {i}: {v} over {}", vmax[i]);
             let dv = (v - prev.joint_velocities[i]).abs();
-            prop_assert!(dv <= amax[i] * DT * (1.0 + 1e-9) + 1e-12, "{robot}: joint {i} step {dv} over {}", amax[i] * DT);
+            prop_assert!(
+                dv <= amax[i] * DT * (1.0 + 1e-9) + 1e-12,
+                "{robot}: joint {i} step {dv} over {}",
+                amax[i] * DT
+            );
         }
         let [vx, vy, wz] = cmd.base_twist;
         prop_assert!([vx, vy, wz].iter().all(|v| v.is_finite()));
@@ -196,7 +215,7 @@ proptest! {
     }
 }
 
-/// Paper 003 Table 1 precontact -> contact on TOMM with a frozen state: the new arrangement's
+/// Interactive-force-control paper Table 1 precontact -> contact on TOMM with a frozen state: the new arrangement's
 /// torque `τ_k` is constant, so by `docs/supervisor.md` the blended torque may change per cycle
 /// by at most `δ_t dt ‖τ_{k-1} − τ_k‖`, and the first torque after the switch is the held one.
 #[test]
@@ -251,11 +270,18 @@ fn absurd_goal_gives_saturated_motion() {
     let cells = vec![CellReading::default(); ctl.config().layout.num_cells()];
     ctl.set_goal(Some(Isometry3::translation(1e6, -1e6, 0.0))).unwrap();
     for k in 0..50 {
-        let out = ctl.update(&ControllerInput { t_s: k as f64 * DT, dt_s: DT, q: &q, qd: &[0.0; 7], cells: &cells, scan: &[] });
+        let out = ctl.update(&ControllerInput {
+            t_s: k as f64 * DT,
+            dt_s: DT,
+            q: &q,
+            qd: &[0.0; 7],
+            cells: &cells,
+            scan: &[],
+        });
         assert_eq!(out.fault, None);
     }
     let v = Vector3::new(ctl.torque()[0], ctl.torque()[1], ctl.torque()[2]);
     assert!(v.iter().all(|t| t.is_finite()));
-    // goal speed saturation (paper 000 eq. 8-9): the task force is bounded by k_v V_max
+    // goal speed saturation (intentional-contact paper eq. 8-9): the task force is bounded by k_v V_max
     assert!(ctl.output().torque_norm < 1e3, "torque {}", ctl.output().torque_norm);
 }

@@ -1,13 +1,13 @@
-//! The hierarchy solver against the properties paper 003 eq. (19)-(25) promise, on the project's
+//! The hierarchy solver against the properties interactive-force-control paper eq. (19)-(25) promise, on the project's
 //! robots (planar7: 7 DoF in the plane; TOMM: base x/y/yaw + two UR5): strict priority, the
 //! posture in the last null space, equivalence with operational-space control for one level,
 //! rank loss (duplicated rows, dependent levels, zero and singular Jacobians), absurd inputs,
-//! continuity through a singularity, and paper 000 force levels composed with acceleration levels.
+//! continuity through a singularity, and intentional-contact paper force levels composed with acceleration levels.
 
 use nalgebra::{DMatrix, DVector, Matrix6xX, SymmetricEigen, Vector3, Vector6};
+use proptest::prelude::*;
 use skin_core::hierarchy::*;
 use skin_core::model::*;
-use proptest::prelude::*;
 
 fn load(file: &str) -> RobotModel {
     let path = format!("{}/../urdf/{file}", env!("CARGO_MANIFEST_DIR"));
@@ -129,7 +129,8 @@ fn hierarchy_strict_priority_tomm_three_levels() {
     let (j2, jd2) = s.task("right_hand", [0.0; 3], &[0, 1, 2]);
     let (j3, jd3) = s.point("left_hand", [0.0; 3]);
     let (x1, x2, x3) = ([0.2, -0.1, 0.3], [0.5, 0.2, -0.4], [0.1, 0.0, -0.2, 0.3, -0.3, 0.1]);
-    let (l1, l2, l3) = (acc_level("wrist", &j1, &jd1, &x1), acc_level("hand", &j2, &jd2, &x2), acc_level("left", &j3, &jd3, &x3));
+    let (l1, l2, l3) =
+        (acc_level("wrist", &j1, &jd1, &x1), acc_level("hand", &j2, &jd2, &x2), acc_level("left", &j3, &jd3, &x3));
     let posture: Vec<f64> = (0..n).map(|i| ((i as f64) * 0.37).cos() * 5.0).collect();
     let (tau, diag) = solve(&s, &[&l1, &l2, &l3], Some(&posture));
     let qdd = s.qdd(&tau);
@@ -140,7 +141,7 @@ fn hierarchy_strict_priority_tomm_three_levels() {
         assert!(res < tol, "residual {res:e}, {diag:?}");
     }
     assert!(diag.iter().all(|d| d.damped == 0 && d.rank == d.rows));
-    // the posture in N_L changes no task acceleration (paper 003 eq. 19, 24)
+    // the posture in N_L changes no task acceleration (interactive-force-control paper eq. 19, 24)
     let (tau0, _) = solve(&s, &[&l1, &l2, &l3], None);
     let dqdd = s.qdd(&(&tau - &tau0));
     assert!((&tau - &tau0).norm() > 1.0, "the posture does act");
@@ -245,13 +246,19 @@ fn hierarchy_tomm_ur5_elbow_and_wrist_singular_is_finite_and_bounded() {
     let model = load("tomm.urdf");
     let n = model.nv();
     let mut q = vec![0.0; n];
-    for (name, v) in [("right_shoulder_lift_joint", -1.0), ("right_elbow_joint", 0.0), ("right_wrist_1_joint", -0.5), ("right_wrist_2_joint", 0.0)] {
+    for (name, v) in [
+        ("right_shoulder_lift_joint", -1.0),
+        ("right_elbow_joint", 0.0),
+        ("right_wrist_1_joint", -0.5),
+        ("right_wrist_2_joint", 0.0),
+    ] {
         q[model.joint_index(name).unwrap()] = v;
     }
     let qd = vec![0.0; n];
     let s = State::new("tomm.urdf", &q, &qd);
     // level 1 locks the base joints (q̈ = 0), level 2 is the 6-D hand task of the right UR5
-    let base: Vec<usize> = ["base_x_joint", "base_y_joint", "base_yaw_joint"].iter().map(|j| model.joint_index(j).unwrap()).collect();
+    let base: Vec<usize> =
+        ["base_x_joint", "base_y_joint", "base_yaw_joint"].iter().map(|j| model.joint_index(j).unwrap()).collect();
     let mut jb = DMatrix::zeros(3, n);
     for (r, &c) in base.iter().enumerate() {
         jb[(r, c)] = 1.0;
@@ -287,7 +294,9 @@ fn hierarchy_absurd_inputs() {
     let mut solver = HierarchySolver::new(7, 4, 4, InverseParams::default()).unwrap();
     let mut out = DVector::from_element(7, 42.0);
     let err = solver.solve(&s.m, [&big, &nan], None, None, &mut out).unwrap_err();
-    assert!(matches!(&err, HierarchyError::NonFiniteLevel { level: 1, name, what: "xdd_star", index: 1, value } if name == "link3_nan" && value.is_nan()));
+    assert!(
+        matches!(&err, HierarchyError::NonFiniteLevel { level: 1, name, what: "xdd_star", index: 1, value } if name == "link3_nan" && value.is_nan())
+    );
     assert!(err.to_string().contains("level 1 (`link3_nan`): xdd_star[1]"), "{err}");
     assert!(out.iter().all(|&t| t == 42.0), "output untouched on error");
 
@@ -362,7 +371,7 @@ fn hierarchy_torque_is_continuous_through_the_singularity() {
 fn hierarchy_force_level_composes_with_acceleration_levels() {
     let s = State::new("planar7.urdf", &P7_BENT, &P7_QD);
     let n = 7;
-    // paper 000 eq. 3-4: a repulsive force along a skin cell normal on link 3
+    // intentional-contact paper eq. 3-4: a repulsive force along a skin cell normal on link 3
     let (jc, _) = s.point("link3", [0.15, 0.02, 0.0]);
     let normal = [0.0, 1.0, 0.0];
     let mut avoid = TaskLevel::new("avoidance", n, 4);
@@ -381,7 +390,7 @@ fn hierarchy_force_level_composes_with_acceleration_levels() {
     let tau_goal = &tau - &jn * 5.0;
     assert!((jn.transpose() * s.qdd(&tau_goal))[0].abs() < 1e-9);
 
-    // goal on top: the force torque is N_1 J_cᵀ F (augmented projection, paper 000 / Dietrich)
+    // goal on top: the force torque is N_1 J_cᵀ F (augmented projection, intentional-contact paper / Dietrich)
     let (t_goal, _) = solve(&s, &[&goal], None);
     let (tau, _) = solve(&s, &[&goal, &avoid], None);
     let minv = s.m.clone().try_inverse().unwrap();
@@ -412,7 +421,10 @@ fn hierarchy_bias_is_added_when_asked() {
     assert!((&b - &a - DVector::from_vec(bias)).amax() < 1e-12);
     // levels with the wrong column count or too many rows are rejected with their name
     let wrong = TaskLevel::new("wrong", 6, 2);
-    assert!(matches!(solver.solve(&s.m, [&wrong], None, None, &mut a), Err(HierarchyError::LevelColumns { level: 0, .. })));
+    assert!(matches!(
+        solver.solve(&s.m, [&wrong], None, None, &mut a),
+        Err(HierarchyError::LevelColumns { level: 0, .. })
+    ));
     let mut l = TaskLevel::new("small", 7, 1);
     let err = l.push(&j1, Reference::Force { f: &[1.0, 2.0] }).unwrap_err();
     assert!(err.to_string().contains("small"), "{err}");
@@ -442,7 +454,7 @@ fn hierarchy_solve_model_matches_solve() {
     assert!((&a - &b - &bias).amax() < 1e-12);
 }
 
-/// Paper 003 eq. (19)-(25) written literally with nalgebra (m × m inverses by `SymmetricEigen`
+/// Interactive-force-control paper eq. (19)-(25) written literally with nalgebra (m × m inverses by `SymmetricEigen`
 /// and the same eigenvalue filter): the reference for the solver's fast paths.
 fn reference_solve(m: &DMatrix<f64>, levels: &[(DMatrix<f64>, DVector<f64>, bool)], p: &InverseParams) -> DVector<f64> {
     let n = m.nrows();
@@ -494,12 +506,20 @@ fn hierarchy_wide_levels_match_the_literal_formulation() {
         }
         let x2 = DVector::from_fn(rows, |_, _| scale * (0.5 + rand()));
         let mut l2 = TaskLevel::new("cells", n, rows);
-        let reference = if force { Reference::Force { f: x2.as_slice() } } else { Reference::Acceleration { xdd_star: x2.as_slice(), jdot_qdot: &vec![0.0; rows] } };
+        let reference = if force {
+            Reference::Force { f: x2.as_slice() }
+        } else {
+            Reference::Acceleration { xdd_star: x2.as_slice(), jdot_qdot: &vec![0.0; rows] }
+        };
         l2.set(&j2, reference).unwrap();
         let (tau, diag) = solve(&s, &[&l1, &l2], None);
         assert!(tau.iter().all(|t| t.is_finite()));
         let x1v = DVector::from_column_slice(&x1) - &jd1;
-        let want = reference_solve(&s.m, &[(j1.clone(), x1v, false), (j2.clone(), x2.clone(), force)], &InverseParams::default());
+        let want = reference_solve(
+            &s.m,
+            &[(j1.clone(), x1v, false), (j2.clone(), x2.clone(), force)],
+            &InverseParams::default(),
+        );
         let err = (&tau - &want).amax() / want.amax().max(1.0);
         assert!(err < 1e-8, "rows {rows}, force {force}: relative difference {err:e}");
         if rows == 50 {
@@ -517,7 +537,8 @@ fn hierarchy_wide_levels_match_the_literal_formulation() {
     lb.set(&jb, Reference::Force { f: fb.as_slice() }).unwrap();
     let (tau, diag) = solve(&s, &[&l1, &la, &lb], None);
     let x1v = DVector::from_column_slice(&x1) - &jd1;
-    let want = reference_solve(&s.m, &[(j1.clone(), x1v, false), (ja, fa, true), (jb, fb, true)], &InverseParams::default());
+    let want =
+        reference_solve(&s.m, &[(j1.clone(), x1v, false), (ja, fa, true), (jb, fb, true)], &InverseParams::default());
     let err = (&tau - &want).amax() / want.amax().max(1.0);
     assert!(err < 1e-8, "two wide levels: relative difference {err:e}");
     assert_eq!((diag[1].rank, diag[2].rank), (5, n - 8), "rank 5, then what the hand and the first level left");
@@ -533,17 +554,27 @@ const TOMM_LEVELS: [(&str, [f64; 3], &[usize]); 4] = [
     ("right_forearm_link", [-0.2, 0.0, 0.05], &[2]),
 ];
 
-/// Strict priority (paper 003 eq. 19-25): the acceleration `J_i q̈ + J̇_i q̇` level `i` gets is the
+/// Strict priority (interactive-force-control paper eq. 19-25): the acceleration `J_i q̈ + J̇_i q̇` level `i` gets is the
 /// same (to 1e-9 relative to the round-off scale below) whether the levels below it (and the posture) are there or not. Random non-singular
 /// states (states where a level loses rank or enters the damping band are skipped: there the
 /// hierarchy deliberately trades accuracy for boundedness) and random references.
-fn strict_priority_case(file: &str, spec: &[(&str, [f64; 3], &[usize])], u: &[f64], refs: &[f64]) -> Result<(), TestCaseError> {
+fn strict_priority_case(
+    file: &str,
+    spec: &[(&str, [f64; 3], &[usize])],
+    u: &[f64],
+    refs: &[f64],
+) -> Result<(), TestCaseError> {
     let model = load(file);
     let n = model.nv();
-    let q: Vec<f64> = model.joint_limits().iter().zip(u).map(|(l, u)| {
-        let (lo, hi) = (l.lower.max(-3.1), l.upper.min(3.1));
-        lo + u * (hi - lo)
-    }).collect();
+    let q: Vec<f64> = model
+        .joint_limits()
+        .iter()
+        .zip(u)
+        .map(|(l, u)| {
+            let (lo, hi) = (l.lower.max(-3.1), l.upper.min(3.1));
+            lo + u * (hi - lo)
+        })
+        .collect();
     let qd: Vec<f64> = u[n..2 * n].iter().map(|v| v - 0.5).collect();
     let s = State::new(file, &q, &qd);
     let mut levels = Vec::new();
@@ -572,7 +603,10 @@ fn strict_priority_case(file: &str, spec: &[(&str, [f64; 3], &[usize])], u: &[f6
         let minv = s.m.clone().try_inverse().unwrap();
         let reach = (j * minv).norm() * (&full - &upper).norm();
         let scale = (j * &qdd_full).amax().max(reach).max(1.0);
-        prop_assert!(diff <= 1e-9 * scale, "{file}: level {i} acceleration changed by {diff:e} (scale {scale:e}) by the levels below");
+        prop_assert!(
+            diff <= 1e-9 * scale,
+            "{file}: level {i} acceleration changed by {diff:e} (scale {scale:e}) by the levels below"
+        );
     }
     Ok(())
 }
@@ -603,7 +637,8 @@ fn activated_case(s: &State, a: [f64; 2]) -> (DVector<f64>, DMatrix<f64>) {
     let mut skin = TaskLevel::new("avoidance", n, 2);
     for ((link, f), a) in [("link3", 4.0), ("link5", 2.0)].into_iter().zip(a) {
         let (jc, _) = s.point(link, [0.1, 0.02, 0.0]);
-        skin.push_row_activated(jc.row(1).transpose().as_slice(), f, a).unwrap(); // direction +y
+        skin.push_row_activated(jc.row(1).transpose().as_slice(), f, a).unwrap();
+        // direction +y
     }
     let (j1, jd1) = s.task("ee", [0.0; 3], &XY);
     let goal = acc_level("goal", &j1, &jd1, &[0.5, -0.3]);
@@ -633,7 +668,8 @@ fn hierarchy_activated_rows_are_exact_at_the_ends_and_continuous_between() {
         let mut skin = TaskLevel::new("avoidance", n, 2);
         for ((link, f), a) in [("link3", 4.0), ("link5", 2.0)].into_iter().zip(a) {
             let (jc, _) = s.point(link, [0.1, 0.02, 0.0]);
-            skin.push_row_activated(jc.row(1).transpose().as_slice(), f, a).unwrap(); // direction +y
+            skin.push_row_activated(jc.row(1).transpose().as_slice(), f, a).unwrap();
+            // direction +y
         }
         let mut solver = HierarchySolver::new(n, 1, 2, InverseParams::default()).unwrap();
         let mut tau = DVector::zeros(n);

@@ -93,21 +93,25 @@ fn moving_leaf_without_mass_makes_m_singular_and_is_rejected() {
     // nothing moves with j2: M would have a zero row; the error names the joint
     let msg = err(&urdf("", "0 1 0", ""));
     assert_names(&msg, &["bad_robot.urdf", "joint \"j2\"", "mass matrix is singular"]);
-    let zero_all = r#"<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>"#;
+    let zero_all =
+        r#"<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>"#;
     assert_names(&err(&urdf(zero_all, "0 1 0", "")), &["bad_robot.urdf", "joint \"j2\"", "singular"]);
-    let neg = r#"<inertial><mass value="-2"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>"#;
+    let neg =
+        r#"<inertial><mass value="-2"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>"#;
     assert_names(&err(&urdf(neg, "0 1 0", "")), &["bad_robot.urdf", "link \"link2\"", "negative mass"]);
 }
 
 #[test]
 fn indefinite_inertia_is_rejected_and_inconsistent_one_kept_with_a_warning() {
-    let not_psd = r#"<inertial><mass value="1"/><inertia ixx="0.1" ixy="0.5" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>"#;
+    let not_psd =
+        r#"<inertial><mass value="1"/><inertia ixx="0.1" ixy="0.5" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>"#;
     assert_names(
         &err(&urdf(not_psd, "0 1 0", "")),
         &["bad_robot.urdf", "link \"link2\"", "line 7", "<inertial>", "not positive semi-definite"],
     );
     // principal moments 0.1, 0.1, 0.5: no real body, but a positive definite spatial inertia
-    let triangle = r#"<inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.5"/></inertial>"#;
+    let triangle =
+        r#"<inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.5"/></inertial>"#;
     let m = RobotModel::from_urdf_str(&urdf(triangle, "0 1 0", ""), "t.urdf").unwrap();
     assert_eq!(m.warnings().len(), 1, "{:?}", m.warnings());
     assert_names(&m.warnings()[0], &["link \"link2\"", "triangle inequality", "3.000e-1", "kept as given"]);
@@ -121,7 +125,8 @@ fn zero_axis_is_rejected() {
 
 #[test]
 fn unsupported_joints_and_structure_errors_name_the_element() {
-    let floating = urdf(GOOD_INERTIAL, "0 1 0", "").replace(r#"name="j2" type="revolute""#, r#"name="j2" type="floating""#);
+    let floating =
+        urdf(GOOD_INERTIAL, "0 1 0", "").replace(r#"name="j2" type="revolute""#, r#"name="j2" type="floating""#);
     assert_names(&err(&floating), &["bad_robot.urdf", "joint \"j2\"", "Floating"]);
     let two_roots = urdf(GOOD_INERTIAL, "0 1 0", r#"<link name="orphan"/>"#);
     assert_names(&err(&two_roots), &["bad_robot.urdf", "multiple root links", "\"orphan\""]);

@@ -9,6 +9,7 @@ use std::path::PathBuf;
 use nalgebra::{DMatrix, DVector, Matrix6xX, Vector3, Vector6};
 use skin_core::hierarchy::*;
 use skin_core::model::*;
+use skin_core::resolver::{Resolver, ResolverParams};
 use skin_core::skin::aggregate::{aggregate_live_patches, aggregate_patches, PatchWrench};
 use skin_core::skin::cell_forces::{cell_contact_forces, cell_repulsion_forces, PointForce};
 use skin_core::skin::layout::SkinLayout;
@@ -17,7 +18,6 @@ use skin_core::skin::params::SkinParams;
 use skin_core::skin::signals::CellReading;
 use skin_core::skin::torques::{patch_wrenches_to_torques, point_forces_to_torques};
 use skin_core::skin::transforms::{patch_poses_world, patch_wrench_world, sum_patch_forces_in_frame};
-use skin_core::resolver::{Resolver, ResolverParams};
 use skin_core::supervisor::*;
 
 struct Counting;
@@ -81,7 +81,7 @@ fn dynamics_do_not_allocate_after_setup() {
         let _ = frame_pose(data, frames[3]);
     };
     step(&mut data); // warm-up
-    // the counter does see heap allocations
+                     // the counter does see heap allocations
     let probe = allocations();
     std::hint::black_box(vec![1u8; 16]);
     assert!(allocations() > probe);
@@ -97,18 +97,14 @@ fn dynamics_do_not_allocate_after_setup() {
 fn skin_cycle_does_not_allocate_after_setup() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
     let model = RobotModel::from_urdf_file(&root.join("urdf/tomm.urdf")).unwrap();
-    let layout = SkinLayout::load(&root.join("config/skin/tomm.yaml"))
-        .unwrap()
-        .resolve(&model)
-        .unwrap();
+    let layout = SkinLayout::load(&root.join("config/skin/tomm.yaml")).unwrap().resolve(&model).unwrap();
     let params = SkinParams::load(&root.join("config/skin_model.yaml")).unwrap();
     let n = layout.num_cells();
     let mut data = ModelData::new(&model);
     let q: Vec<f64> = (0..model.nv()).map(|i| 0.2 * i as f64 - 0.4).collect();
     let qd = vec![0.0; model.nv()];
-    let readings: Vec<CellReading> = (0..n)
-        .map(|i| CellReading::uniform((i % 7) as f64 / 7.0, (i % 5) as f64 / 5.0))
-        .collect();
+    let readings: Vec<CellReading> =
+        (0..n).map(|i| CellReading::uniform((i % 7) as f64 / 7.0, (i % 5) as f64 / 5.0)).collect();
     let hand = model.frame_index("right_hand").unwrap();
 
     // Setup: buffers reserved once.
@@ -134,15 +130,8 @@ fn skin_cycle_does_not_allocate_after_setup() {
         )
         .unwrap();
         point_forces_to_torques(&model, data, &forces, &mut tau);
-        cell_contact_forces(
-            &layout,
-            &readings,
-            &params.force,
-            &params.fusion,
-            |f| data.frame_pose(f),
-            &mut forces,
-        )
-        .unwrap();
+        cell_contact_forces(&layout, &readings, &params.force, &params.fusion, |f| data.frame_pose(f), &mut forces)
+            .unwrap();
         point_forces_to_torques(&model, data, &forces, &mut tau);
         std::hint::black_box((h, w, &tau));
     };
@@ -168,7 +157,10 @@ fn hierarchy_does_not_allocate_after_setup() {
     let hand = model.frame_index("right_hand").unwrap();
     let forearm = model.frame_index("right_forearm_link").unwrap();
     let left = model.frame_index("left_hand").unwrap();
-    let mut levels: Vec<TaskLevel> = [("cells", 8), ("wrist", 3), ("hand", 3), ("left", 6)].iter().map(|&(name, rows)| TaskLevel::new(name, n, rows)).collect();
+    let mut levels: Vec<TaskLevel> = [("cells", 8), ("wrist", 3), ("hand", 3), ("left", 6)]
+        .iter()
+        .map(|&(name, rows)| TaskLevel::new(name, n, rows))
+        .collect();
     let mut solver = HierarchySolver::new(n, 4, 8, InverseParams::default()).unwrap();
     let mut tau = DVector::zeros(n);
     let posture = vec![0.3; n];
@@ -185,13 +177,19 @@ fn hierarchy_does_not_allocate_after_setup() {
         for c in 0..active_cells {
             let cell = Vector3::new(-0.05 * c as f64, 0.0, 0.05);
             point_jacobian(&model, &data, forearm, &cell, &mut j).unwrap();
-            levels[0].push_directional(&[0.0, 0.6, 0.8], &j.fixed_rows::<3>(0), Reference::Force { f: &[2.0] }).unwrap();
+            levels[0]
+                .push_directional(&[0.0, 0.6, 0.8], &j.fixed_rows::<3>(0), Reference::Force { f: &[2.0] })
+                .unwrap();
         }
         point_jacobian(&model, &data, hand, &p0, &mut j).unwrap();
         point_jacobian_dot_qdot(&model, &data, hand, &p0, &mut jd).unwrap();
         let (ang, lin) = ([jd[3], jd[4], jd[5]], [jd[0], jd[1], jd[2]]);
-        levels[1].set(&j.fixed_rows::<3>(3), Reference::Acceleration { xdd_star: &[0.1, 0.0, 0.0], jdot_qdot: &ang }).unwrap();
-        levels[2].set(&j.fixed_rows::<3>(0), Reference::Acceleration { xdd_star: &[0.0, 0.2, 0.0], jdot_qdot: &lin }).unwrap();
+        levels[1]
+            .set(&j.fixed_rows::<3>(3), Reference::Acceleration { xdd_star: &[0.1, 0.0, 0.0], jdot_qdot: &ang })
+            .unwrap();
+        levels[2]
+            .set(&j.fixed_rows::<3>(0), Reference::Acceleration { xdd_star: &[0.0, 0.2, 0.0], jdot_qdot: &lin })
+            .unwrap();
         point_jacobian(&model, &data, left, &p0, &mut j).unwrap();
         point_jacobian_dot_qdot(&model, &data, left, &p0, &mut jd).unwrap();
         levels[3].set(&j, Reference::Acceleration { xdd_star: &[0.0; 6], jdot_qdot: jd.as_slice() }).unwrap();
@@ -233,19 +231,11 @@ fn supervisor_and_blend_do_not_allocate() {
         };
         let a = sup.update(t, &u);
         blender.sync(a);
-        let tau = if a.mode == Mode::Avoidance {
-            &tau_a
-        } else {
-            &tau_b
-        };
+        let tau = if a.mode == Mode::Avoidance { &tau_a } else { &tau_b };
         blender.apply(t, tau, &mut out);
     }
     let after = allocations();
-    assert!(
-        sup.log().total() >= 10,
-        "the scenario must switch: {}",
-        sup.log().total()
-    );
+    assert!(sup.log().total() >= 10, "the scenario must switch: {}", sup.log().total());
     assert_eq!(after - before, 0, "allocations during updates");
 }
 
@@ -265,8 +255,7 @@ fn resolver_cycle_does_not_allocate_after_setup() {
         tau[k % n] = -tau[k % n];
         r.update_arms(&tau, &g, &q, &qd, 0.008).unwrap();
         r.update_base(&tau, &q, &qd, 0.001).unwrap();
-        r.update(&tau, &g, &q, &qd, 0.002 + 1e-4 * k as f64)
-            .unwrap();
+        r.update(&tau, &g, &q, &qd, 0.002 + 1e-4 * k as f64).unwrap();
         // the error path too (its error carries no heap data)
         let bad = tau[3];
         tau[3] = f64::NAN;
@@ -282,11 +271,7 @@ fn resolver_cycle_does_not_allocate_after_setup() {
     for k in 1..20 {
         cycle(&mut r, k);
     }
-    assert_eq!(
-        allocations() - before,
-        0,
-        "heap allocations in the resolver cycle"
-    );
+    assert_eq!(allocations() - before, 0, "heap allocations in the resolver cycle");
 }
 
 #[test]
@@ -380,7 +365,7 @@ fn tasks_do_not_allocate_after_setup() {
 }
 
 /// The whole cycle (`Controller::update`) on TOMM with skin activity, a goal and a laser scan,
-/// across arrangement switches of both policies (paper 003 phases on request; paper 000 (a) -> (c)
+/// across arrangement switches of both policies (interactive-force-control paper phases on request; intentional-contact paper (a) -> (c)
 /// on a contact force), through a safe-stop step and with a commanded base motion.
 #[test]
 fn controller_cycle_does_not_allocate_after_setup() {
@@ -398,17 +383,21 @@ fn controller_cycle_does_not_allocate_after_setup() {
         for i in (0..n).step_by(11) {
             cells[i] = CellReading::uniform(0.0, 0.7);
         }
-        let scan: Vec<Vector2<f64>> = (0..360).map(|k| {
-            let a = (k as f64).to_radians();
-            Vector2::new(a.cos(), a.sin()) * 0.7
-        }).collect();
+        let scan: Vec<Vector2<f64>> = (0..360)
+            .map(|k| {
+                let a = (k as f64).to_radians();
+                Vector2::new(a.cos(), a.sin()) * 0.7
+            })
+            .collect();
         let mut c = Controller::new(config, 0.0).unwrap();
         c.set_goal(Some(Isometry3::translation(0.6, -0.3, 1.1))).unwrap();
         let qd = vec![0.01; nv];
         let mut t = 0.0;
         let mut step = |c: &mut Controller, cells: &[CellReading], dt: f64| {
             t += 0.008;
-            c.update(&ControllerInput { t_s: t, dt_s: dt, q: &q, qd: &qd, cells, scan: &scan }).commands.joint_velocities[0]
+            c.update(&ControllerInput { t_s: t, dt_s: dt, q: &q, qd: &qd, cells, scan: &scan })
+                .commands
+                .joint_velocities[0]
         };
         for _ in 0..5 {
             step(&mut c, &cells, 0.008);
@@ -419,13 +408,13 @@ fn controller_cycle_does_not_allocate_after_setup() {
                 let _ = c.request_phase(Phase::Contact);
             }
             if k == 20 {
-                // hard contact on many cells: (a) -> (c) under the paper 000 policy
+                // hard contact on many cells: (a) -> (c) under the intentional-contact paper policy
                 for i in (0..n).step_by(5) {
                     cells[i] = CellReading::uniform(1.0, 1.0);
                 }
             }
             if (40..50).contains(&k) {
-                // a commanded base motion (paper 003 Exp. 1), then back to q_post
+                // a commanded base motion (interactive-force-control paper Exp. 1), then back to q_post
                 let r = BaseReference { position: [0.01 * k as f64, 0.0, 0.0], velocity: [0.05, 0.0, 0.0] };
                 c.set_base_reference(Some(r)).unwrap();
             } else if k == 50 {

@@ -28,9 +28,7 @@ fn load(robot: &str) -> (RobotModel, ResolvedLayout, SkinLayout) {
 }
 
 fn config_q(model: &RobotModel, seed: f64) -> Vec<f64> {
-    (0..model.nv())
-        .map(|i| 0.6 * ((i as f64 + 1.0) * 1.3 + seed).sin())
-        .collect()
+    (0..model.nv()).map(|i| 0.6 * ((i as f64 + 1.0) * 1.3 + seed).sin()).collect()
 }
 
 /// World pose of link `frame` at configuration `q`.
@@ -43,52 +41,24 @@ fn link_state(model: &RobotModel, data: &mut ModelData, q: &[f64], frame: usize)
 #[test]
 fn shipped_layouts_resolve_with_expected_counts() {
     let (tomm, l, raw) = load("tomm");
-    assert!(
-        (600..=800).contains(&l.num_cells()),
-        "tomm cells: {}",
-        l.num_cells()
-    );
+    assert!((600..=800).contains(&l.num_cells()), "tomm cells: {}", l.num_cells());
     assert_eq!(l.patches().len(), raw.patches.len());
     // Both arms: upper arm, forearm, wrists and palms.
     for side in ["left", "right"] {
-        for link in [
-            "upper_arm_link",
-            "forearm_link",
-            "wrist_1_link",
-            "wrist_2_link",
-            "wrist_3_link",
-            "palm",
-        ] {
+        for link in ["upper_arm_link", "forearm_link", "wrist_1_link", "wrist_2_link", "wrist_3_link", "palm"] {
             let name = format!("{side}_{link}");
-            let p = l
-                .patches()
-                .iter()
-                .find(|p| p.link == name)
-                .unwrap_or_else(|| panic!("no patch on {name}"));
+            let p = l.patches().iter().find(|p| p.link == name).unwrap_or_else(|| panic!("no patch on {name}"));
             assert!(!p.cells.is_empty());
             assert_eq!(Some(p.frame), tomm.frame_index(&name));
         }
     }
     let (_, p7, _) = load("planar7");
     assert_eq!(p7.patches().len(), 7);
-    assert!(
-        (150..=500).contains(&p7.num_cells()),
-        "planar7 cells: {}",
-        p7.num_cells()
-    );
+    assert!((150..=500).contains(&p7.num_cells()), "planar7 cells: {}", p7.num_cells());
     for p in p7.patches() {
         // Cells facing within the x-y plane (link ±y) on every link.
-        let in_plane = |s: f64| {
-            p7.cells()[p.cells.clone()]
-                .iter()
-                .filter(|c| (c.normal_link.y * s) > 0.99)
-                .count()
-        };
-        assert!(
-            in_plane(1.0) >= 3 && in_plane(-1.0) >= 3,
-            "patch {} lacks in-plane cells",
-            p.link
-        );
+        let in_plane = |s: f64| p7.cells()[p.cells.clone()].iter().filter(|c| (c.normal_link.y * s) > 0.99).count();
+        assert!(in_plane(1.0) >= 3 && in_plane(-1.0) >= 3, "patch {} lacks in-plane cells", p.link);
     }
     for c in l.cells().iter().chain(p7.cells()) {
         assert_relative_eq!(c.normal_link.norm(), 1.0, epsilon = 1e-9);
@@ -97,10 +67,7 @@ fn shipped_layouts_resolve_with_expected_counts() {
 
 fn spec(links: &[&str], pitch: f64, faces: Vec<(String, Vec<Face>)>) -> GeneratorSpec {
     GeneratorSpec {
-        links: links
-            .iter()
-            .map(|s| s.parse::<LinkSelection>().unwrap())
-            .collect(),
+        links: links.iter().map(|s| s.parse::<LinkSelection>().unwrap()).collect(),
         pitch_m: pitch,
         faces,
         spheres: false,
@@ -114,10 +81,7 @@ fn header_command(text: &str) -> Vec<String> {
         .lines()
         .find(|l| l.trim_start_matches('#').trim().starts_with("skin_layout "))
         .expect("header with the skin_layout command");
-    line.trim_start_matches('#')
-        .split_whitespace()
-        .map(str::to_string)
-        .collect()
+    line.trim_start_matches('#').split_whitespace().map(str::to_string).collect()
 }
 
 #[test]
@@ -126,48 +90,27 @@ fn shipped_layouts_match_the_generator() {
         let path = root().join(format!("config/skin/{robot}.yaml"));
         let text = std::fs::read_to_string(&path).unwrap();
         let cmd = header_command(&text);
-        let arg = |name: &str| {
-            cmd.iter()
-                .position(|a| a == name)
-                .map(|i| cmd[i + 1].clone())
-        };
-        let links: Vec<String> = arg("--links")
-            .unwrap()
-            .split(',')
-            .map(str::to_string)
-            .collect();
+        let arg = |name: &str| cmd.iter().position(|a| a == name).map(|i| cmd[i + 1].clone());
+        let links: Vec<String> = arg("--links").unwrap().split(',').map(str::to_string).collect();
         let links: Vec<&str> = links.iter().map(String::as_str).collect();
         let pitch: f64 = arg("--pitch").map(|p| p.parse().unwrap()).unwrap_or(0.025);
         let mut faces = Vec::new();
         for (i, a) in cmd.iter().enumerate() {
             if a == "--faces" {
                 let (l, f) = cmd[i + 1].split_once('=').unwrap();
-                faces.push((
-                    l.to_string(),
-                    f.split(',').map(|x| x.parse().unwrap()).collect(),
-                ));
+                faces.push((l.to_string(), f.split(',').map(|x| x.parse().unwrap()).collect()));
             }
         }
-        assert!(
-            arg("--patch-frame").is_none() && !cmd.iter().any(|a| a == "--spheres"),
-            "extend this test"
-        );
+        assert!(arg("--patch-frame").is_none() && !cmd.iter().any(|a| a == "--spheres"), "extend this test");
         let model = RobotModel::from_urdf_file(&root().join(arg("--urdf").unwrap())).unwrap();
         let generated = generate_layout(&model, &spec(&links, pitch, faces)).unwrap();
         let shipped = SkinLayout::load(&path).unwrap();
-        assert_eq!(
-            generated.cells.len(),
-            shipped.cells.len(),
-            "{robot}: regenerate the layout"
-        );
+        assert_eq!(generated.cells.len(), shipped.cells.len(), "{robot}: regenerate the layout");
         assert_eq!(generated.patches.len(), shipped.patches.len());
         for (g, s) in generated.cells.iter().zip(&shipped.cells) {
             assert_eq!((g.id, g.patch), (s.id, s.patch));
             for k in 0..3 {
-                assert!(
-                    (g.position[k] - s.position[k]).abs() < 1e-6
-                        && (g.normal[k] - s.normal[k]).abs() < 1e-6
-                );
+                assert!((g.position[k] - s.position[k]).abs() < 1e-6 && (g.normal[k] - s.normal[k]).abs() < 1e-6);
             }
         }
     }
@@ -176,13 +119,9 @@ fn shipped_layouts_match_the_generator() {
 #[test]
 fn generator_rejects_bad_input_and_normals_point_outward() {
     let model = RobotModel::from_urdf_file(&root().join("urdf/planar7.urdf")).unwrap();
-    let e = generate_layout(&model, &spec(&["nope"], 0.025, vec![]))
-        .unwrap_err()
-        .to_string();
+    let e = generate_layout(&model, &spec(&["nope"], 0.025, vec![])).unwrap_err().to_string();
     assert!(e.contains("planar7.urdf") && e.contains("nope"), "{e}");
-    let e = generate_layout(&model, &spec(&["link1:9"], 0.025, vec![]))
-        .unwrap_err()
-        .to_string();
+    let e = generate_layout(&model, &spec(&["link1:9"], 0.025, vec![])).unwrap_err().to_string();
     assert!(e.contains("link1") && e.contains('9'), "{e}");
     assert!(generate_layout(&model, &spec(&["link1"], 0.0, vec![])).is_err());
     // Cylinder of link1 lies along link x at y = z = 0: normals radial, outward.
@@ -236,11 +175,7 @@ fn cell_torques_match_jacobian_and_virtual_work() {
         let n_world = data.frame_pose(c.frame).rotation * c.normal_link;
         assert_relative_eq!(f.force.normalize(), -n_world, epsilon = 1e-12);
         let d = params.proximity.distance_m(readings[f.cell].proximity);
-        assert_relative_eq!(
-            f.force.norm(),
-            params.repulsion.linear_n(d),
-            epsilon = 1e-12
-        );
+        assert_relative_eq!(f.force.norm(), params.repulsion.linear_n(d), epsilon = 1e-12);
     }
     assert_relative_eq!(tau, expected, epsilon = 1e-10);
 
@@ -263,7 +198,7 @@ fn cell_torques_match_jacobian_and_virtual_work() {
     assert!(tau.norm() > 1.0, "non-trivial torques");
 }
 
-/// Paper 003 eq. (14) torques of patch wrenches equal the virtual work of force and moment.
+/// Interactive-force-control paper eq. (14) torques of patch wrenches equal the virtual work of force and moment.
 #[test]
 fn patch_torques_match_virtual_work() {
     let (model, layout, _) = load("tomm");
@@ -278,11 +213,7 @@ fn patch_torques_match_virtual_work() {
             readings[i] = CellReading::uniform(0.2 + 0.1 * k as f64, 0.5);
         }
     }
-    let fusion = FusionParams {
-        weight_force: 0.5,
-        activity_threshold: 0.01,
-        force_reduction: ForceReduction::Mean,
-    };
+    let fusion = FusionParams { weight_force: 0.5, activity_threshold: 0.01, force_reduction: ForceReduction::Mean };
     let mut wrenches: Vec<PatchWrench> = Vec::new();
     aggregate_patches(&layout, &readings, &fusion, &mut wrenches).unwrap();
     assert!(wrenches.iter().all(|w| w.active_cells == 5));
@@ -318,38 +249,16 @@ fn contact_forces_inward_with_newtons() {
     let (model, layout, _) = load("planar7");
     let params = SkinParams::load(&root().join("config/skin_model.yaml")).unwrap();
     let mut data = ModelData::new(&model);
-    update_kinematics(
-        &model,
-        &mut data,
-        &config_q(&model, 0.0),
-        &vec![0.0; model.nv()],
-    )
-    .unwrap();
+    update_kinematics(&model, &mut data, &config_q(&model, 0.0), &vec![0.0; model.nv()]).unwrap();
     let mut readings = vec![CellReading::default(); layout.num_cells()];
     let i = layout.patches()[3].cells.start + 2;
     readings[i] = CellReading::uniform(params.force.signal(4.0), 0.0);
     let mut out: Vec<PointForce> = Vec::new();
-    cell_contact_forces(
-        &layout,
-        &readings,
-        &params.force,
-        &params.fusion,
-        |f| data.frame_pose(f),
-        &mut out,
-    )
-    .unwrap();
+    cell_contact_forces(&layout, &readings, &params.force, &params.fusion, |f| data.frame_pose(f), &mut out).unwrap();
     assert_eq!(out.len(), 1);
     assert_relative_eq!(out[0].force.norm(), 4.0, epsilon = 1e-9);
     let c = &layout.cells()[i];
     let pose = data.frame_pose(c.frame);
-    assert_relative_eq!(
-        out[0].force / 4.0,
-        -(pose.rotation * c.normal_link),
-        epsilon = 1e-9
-    );
-    assert_relative_eq!(
-        out[0].point,
-        (pose * Point3::from(c.position_link)).coords,
-        epsilon = 1e-12
-    );
+    assert_relative_eq!(out[0].force / 4.0, -(pose.rotation * c.normal_link), epsilon = 1e-9);
+    assert_relative_eq!(out[0].point, (pose * Point3::from(c.position_link)).coords, epsilon = 1e-12);
 }

@@ -15,7 +15,9 @@ fn run(args: &[&str]) -> Output {
 fn matrix_shape(v: &Value) -> (usize, usize) {
     let rows = v.as_array().unwrap();
     let cols = rows[0].as_array().unwrap().len();
-    assert!(rows.iter().all(|r| r.as_array().unwrap().len() == cols && r.as_array().unwrap().iter().all(Value::is_f64)));
+    assert!(rows
+        .iter()
+        .all(|r| r.as_array().unwrap().len() == cols && r.as_array().unwrap().iter().all(Value::is_f64)));
     (rows.len(), cols)
 }
 

@@ -5,8 +5,8 @@
 
 use nalgebra::{DMatrix, DVector, Matrix6xX, Vector3, Vector6};
 use skin_core::model::{
-    bias_forces, crba, gravity, point_jacobian, point_jacobian_dot_qdot, update_kinematics, MimicMode, ModelData, RobotModel,
-    UrdfOptions,
+    bias_forces, crba, gravity, point_jacobian, point_jacobian_dot_qdot, update_kinematics, MimicMode, ModelData,
+    RobotModel, UrdfOptions,
 };
 
 fn load(xml: &str) -> RobotModel {
@@ -92,18 +92,34 @@ fn format_extras_the_model_does_not_use_are_ignored() {
 
 #[test]
 fn what_the_specification_requires_is_required() {
-    let no_limit = two_links(&inertial(1.0, [0.1, 0.1, 0.1], "0 0 0.2"))
-        .replace(r#"<limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
-</robot>"#, "</joint>\n</robot>");
-    assert_names(&err(&no_limit, MimicMode::Independent), &["robots/test.urdf", "joint \"j2\" (line 7)", "missing <limit>"]);
-    let bad_number = two_links(&inertial(1.0, [0.1, 0.1, 0.1], "0 0 0.2")).replace(r#"xyz="0.3 0 0""#, r#"xyz="0.3 0""#);
-    assert_names(&err(&bad_number, MimicMode::Independent), &["joint \"j2\" <origin> (line 7)", "xyz=\"0.3 0\"", "3 finite"]);
+    let no_limit = two_links(&inertial(1.0, [0.1, 0.1, 0.1], "0 0 0.2")).replace(
+        r#"<limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+</robot>"#,
+        "</joint>\n</robot>",
+    );
+    assert_names(
+        &err(&no_limit, MimicMode::Independent),
+        &["robots/test.urdf", "joint \"j2\" (line 7)", "missing <limit>"],
+    );
+    let bad_number =
+        two_links(&inertial(1.0, [0.1, 0.1, 0.1], "0 0 0.2")).replace(r#"xyz="0.3 0 0""#, r#"xyz="0.3 0""#);
+    assert_names(
+        &err(&bad_number, MimicMode::Independent),
+        &["joint \"j2\" <origin> (line 7)", "xyz=\"0.3 0\"", "3 finite"],
+    );
     let mesh = two_links(r#"<collision><geometry><mesh scale="1 1 1"/></geometry></collision>"#);
-    assert_names(&err(&mesh, MimicMode::Independent), &["link \"link2\" <mesh> (line 4)", "missing attribute `filename`"]);
+    assert_names(
+        &err(&mesh, MimicMode::Independent),
+        &["link \"link2\" <mesh> (line 4)", "missing attribute `filename`"],
+    );
     let no_mass = two_links(r#"<inertial><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>"#);
     assert_names(&err(&no_mass, MimicMode::Independent), &["link \"link2\" <inertial> (line 4)", "missing <mass>"]);
-    let planar = two_links(&inertial(1.0, [0.1, 0.1, 0.1], "0 0 0.2")).replace(r#"name="j2" type="revolute""#, r#"name="j2" type="planar""#);
-    assert_names(&err(&planar, MimicMode::Independent), &["unsupported", "joint \"j2\"", "Planar joints are not supported"]);
+    let planar = two_links(&inertial(1.0, [0.1, 0.1, 0.1], "0 0 0.2"))
+        .replace(r#"name="j2" type="revolute""#, r#"name="j2" type="planar""#);
+    assert_names(
+        &err(&planar, MimicMode::Independent),
+        &["unsupported", "joint \"j2\"", "Planar joints are not supported"],
+    );
 }
 
 #[test]
@@ -116,7 +132,10 @@ fn inertia_noise_below_positive_semi_definiteness_is_clipped_with_a_warning() {
     assert!(i[(2, 2)].abs() < 1e-15 && (i[(0, 0)] - 0.1).abs() < 1e-15, "{i}");
     // beyond the tolerance: refused, naming link, line and the moments
     let e = err(&two_links(&inertial(1.0, [0.1, 0.1, -2e-7], "0 0 0.2")), MimicMode::Independent);
-    assert_names(&e, &["robots/test.urdf", "link \"link2\" (line 4) <inertial>", "not positive semi-definite", "-2.0000e-7"]);
+    assert_names(
+        &e,
+        &["robots/test.urdf", "link \"link2\" (line 4) <inertial>", "not positive semi-definite", "-2.0000e-7"],
+    );
 }
 
 #[test]
@@ -278,10 +297,16 @@ fn followed_mimic_joints_compose_jacobian_and_mass_matrix() {
 fn mimic_errors_name_the_joint_in_follow_mode_only() {
     let unknown = mimic_chain(-0.7).replace(r#"<mimic joint="j1""#, r#"<mimic joint="nope""#);
     assert_eq!(load(&unknown).nv(), 4, "independent mode ignores <mimic>");
-    assert_names(&err(&unknown, MimicMode::Follow), &["joint \"j2\" (line 5) <mimic>", "\"nope\", which is not a moving joint"]);
-    let cycle = mimic_chain(-0.7).replace(r#"<limit lower="-2" upper="2" velocity="1" effort="1"/></joint>
-  <joint name="j2""#, r#"<limit lower="-2" upper="2" velocity="1" effort="1"/><mimic joint="j3"/></joint>
-  <joint name="j2""#);
+    assert_names(
+        &err(&unknown, MimicMode::Follow),
+        &["joint \"j2\" (line 5) <mimic>", "\"nope\", which is not a moving joint"],
+    );
+    let cycle = mimic_chain(-0.7).replace(
+        r#"<limit lower="-2" upper="2" velocity="1" effort="1"/></joint>
+  <joint name="j2""#,
+        r#"<limit lower="-2" upper="2" velocity="1" effort="1"/><mimic joint="j3"/></joint>
+  <joint name="j2""#,
+    );
     assert_names(&err(&cycle, MimicMode::Follow), &["<mimic>", "cycle"]);
 }
 

@@ -1,4 +1,4 @@
-//! The scene's commanded base motions (`base_motions`, paper 003 Exp. 1: "the base is commanded
+//! The scene's commanded base motions (`base_motions`, interactive-force-control paper Exp. 1: "the base is commanded
 //! to move on a circle with a radius of 0.2 m", then "lateral swings parallel to the table"),
 //! turned into the controller's [`BaseReference`] per cycle: the posture level's moving target
 //! `q_d(t)`, `q̇_d(t)` of the base joints (`Controller::set_base_reference`).
@@ -77,10 +77,7 @@ impl BaseMotions {
             .iter()
             .find(|m| t_s >= m.start_s && t_s < m.end_s)
             .map_or(([0.0; 2], [0.0; 2]), |m| m.offset(t_s));
-        Some(BaseReference {
-            position: [origin[0] + p[0], origin[1] + p[1], origin[2]],
-            velocity: [v[0], v[1], 0.0],
-        })
+        Some(BaseReference { position: [origin[0] + p[0], origin[1] + p[1], origin[2]], velocity: [v[0], v[1], 0.0] })
     }
 }
 

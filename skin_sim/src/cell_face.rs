@@ -1,6 +1,6 @@
 //! The sensing face of one skin cell and how deep a touching geom presses into it.
 //!
-//! A real cell (paper 003 Sec. 4.1.2: a rigid element about the size of a two-euro coin, force
+//! A real cell (interactive-force-control paper Sec. 4.1.2: a rigid element about the size of a two-euro coin, force
 //! sensors under a soft cover) reads the pressure on its whole face; the cover's pressure grows
 //! with its local compression. The face is sampled as a disk of the cell's radius with the 7-point
 //! rule (centre weight 1/4, six points at `sqrt(2/3) r` with 1/8 each, exact for cubic
@@ -32,7 +32,8 @@ pub(crate) struct CellFace {
 impl CellFace {
     /// The disk of `radius_m` around `centre` facing along the unit vector `normal` (body frame).
     pub(crate) fn new(centre: Point3<f64>, normal: Vector3<f64>, radius_m: f64) -> Self {
-        let u = normal.cross(&Vector3::x()).try_normalize(1e-6).unwrap_or_else(|| normal.cross(&Vector3::y()).normalize());
+        let u =
+            normal.cross(&Vector3::x()).try_normalize(1e-6).unwrap_or_else(|| normal.cross(&Vector3::y()).normalize());
         let v = normal.cross(&u);
         let r = radius_m * (2.0f64 / 3.0).sqrt();
         let mut points = [centre; 7];

@@ -19,8 +19,8 @@ use thiserror::Error;
 use crate::interaction::Interactions;
 use crate::probe::ContactProbe;
 use crate::record::{mode_name, CycleRecord, RunRecord, Switch};
-use crate::schedule::{Schedule, ScheduleError, ScheduledInputs};
 use crate::scene::Scene;
+use crate::schedule::{Schedule, ScheduleError, ScheduledInputs};
 use crate::view::ViewRecorder;
 use crate::world::{World, WorldError};
 
@@ -85,11 +85,7 @@ impl ClosedLoop {
         };
         let model = &controller.config().model;
         if model.joint_names() != scene.model.joint_names() {
-            return Err(mismatch(format!(
-                "joints {:?} vs {:?}",
-                scene.model.joint_names(),
-                model.joint_names()
-            )));
+            return Err(mismatch(format!("joints {:?} vs {:?}", scene.model.joint_names(), model.joint_names())));
         }
         if controller.resolver().arm_joints() != world.arm_joints() {
             return Err(mismatch("the resolver's arm joints are not the world's".into()));
@@ -99,10 +95,8 @@ impl ClosedLoop {
             let n = controller.config().layout.num_cells();
             return Err(mismatch(format!("{cells} skin cells in the scene, {n} in the controller's layout")));
         }
-        let schedule = Schedule::new(scene, &controller).map_err(|error| LoopError::Schedule {
-            file: scene.file.clone(),
-            error,
-        })?;
+        let schedule = Schedule::new(scene, &controller)
+            .map_err(|error| LoopError::Schedule { file: scene.file.clone(), error })?;
         let ee = model.frame_index(&controller.config().setup.end_effector).expect("checked by Controller::new");
         let spec = &scene.spec;
         let record = RunRecord {
@@ -204,18 +198,12 @@ impl ClosedLoop {
         };
         let mut event = self.record.cycles.is_empty().then(|| "start".to_string());
         if let Some(tr) = self.controller.supervisor().last_transition() {
-            self.record.switches.push(Switch {
-                t_s: tr.t_s,
-                from: tr.from,
-                to: tr.to,
-            });
+            self.record.switches.push(Switch { t_s: tr.t_s, from: tr.from, to: tr.to });
             event = Some(format!("{} -> {}", mode_name(tr.from), mode_name(tr.to)));
         }
         self.view.cycle(&self.world, cycle.mode, event);
         let commands = &self.controller.output().commands;
-        self.world
-            .set_arm_velocity_commands(&commands.joint_velocities)
-            .expect("arm joints checked in new");
+        self.world.set_arm_velocity_commands(&commands.joint_velocities).expect("arm joints checked in new");
         self.world.set_base_twist(commands.base_twist);
         for _ in 0..self.steps_per_cycle {
             self.world.step();

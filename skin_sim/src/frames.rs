@@ -25,14 +25,9 @@ impl FrameRef {
                 .name_to_id(MjtObjBase::mjOBJ_BODY, body_name(model, j))
                 .expect("the generated MJCF has a body per model joint"),
             // A world-fixed link with geometry has a static body of its own (at the origin).
-            None => mj
-                .name_to_id(MjtObjBase::mjOBJ_BODY, &model.frame_names()[frame])
-                .unwrap_or(0),
+            None => mj.name_to_id(MjtObjBase::mjOBJ_BODY, &model.frame_names()[frame]).unwrap_or(0),
         };
-        FrameRef {
-            body,
-            placement: *model.frame_placement(frame),
-        }
+        FrameRef { body, placement: *model.frame_placement(frame) }
     }
 
     /// World pose of the frame at the data's current kinematics.
@@ -45,8 +40,5 @@ impl FrameRef {
 pub(crate) fn body_pose<M: ModelType>(data: &MjData<M>, body: usize) -> Isometry3<f64> {
     let [x, y, z] = data.xpos()[body];
     let [w, i, j, k] = data.xquat()[body];
-    Isometry3::from_parts(
-        Translation3::new(x, y, z),
-        UnitQuaternion::new_unchecked(Quaternion::new(w, i, j, k)),
-    )
+    Isometry3::from_parts(Translation3::new(x, y, z), UnitQuaternion::new_unchecked(Quaternion::new(w, i, j, k)))
 }

@@ -1,7 +1,7 @@
 //! When the scene's user interacts with the robot: a scripted push on a robot link (touches of
-//! paper 003 Exp. 2-4, green areas) or a person within the base avoidance range of the base
-//! footprint (red areas), or a commanded base motion (paper 003 Exp. 1's circle and swings).
-//! Paper 003 Table 3 splits the force-tracking error by these periods.
+//! interactive-force-control paper Exp. 2-4, green areas) or a person within the base avoidance range of the base
+//! footprint (red areas), or a commanded base motion (interactive-force-control paper Exp. 1's circle and swings).
+//! Interactive-force-control paper Table 3 splits the force-tracking error by these periods.
 
 use skin_core::resolver::BASE_JOINTS;
 use skin_core::tasks::params::BaseAvoidanceParams;

@@ -1,6 +1,6 @@
 //! Simulated planar LIDAR: a fan of rays in the x-y plane of the scanner's frame, cast against
 //! objects and persons ([`SENSED_GROUPS`], never the robot), reported as 2-D points in the BASE
-//! frame (x forward, y left): the closest-obstacle points that base avoidance consumes (paper 003
+//! frame (x forward, y left): the closest-obstacle points that base avoidance consumes (interactive-force-control paper
 //! eq. (15)-(17)). Ranges get optional seeded Gaussian noise.
 
 use mujoco_rs::prelude::*;

@@ -1,6 +1,6 @@
 //! Numbers of a run (`metrics.json`): always the run's cost and the arrangement switches; goal and
-//! contact-force figures for scenes with goals (paper 000); force-tracking figures for scenes
-//! with force references (paper 003 Table 3).
+//! contact-force figures for scenes with goals (intentional-contact paper); force-tracking figures for scenes
+//! with force references (interactive-force-control paper Table 3).
 
 use serde::Serialize;
 use skin_core::resolver::BASE_JOINTS;
@@ -52,19 +52,19 @@ pub struct Metrics {
     pub arrangement_switches: Vec<SwitchEntry>,
     /// Cycles that were safe-stop steps (a fault of the controller or of its inputs).
     pub faulted_cycles: usize,
-    /// Paper 000 figures (scenes with goals).
+    /// Intentional-contact paper figures (scenes with goals).
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub goal: Option<GoalMetrics>,
-    /// Paper 003 figures (scenes with force references).
+    /// Interactive-force-control paper figures (scenes with force references).
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub force: Option<ForceMetrics>,
-    /// Scenes with neither goals nor force references (paper 003 Exp. 2's pre-contact approach
+    /// Scenes with neither goals nor force references (interactive-force-control paper Exp. 2's pre-contact approach
     /// and guidance): nothing of the robot may press on the environment.
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub contact_free: Option<ContactFreeMetrics>,
 }
 
-/// A scene in which the robot should touch nothing (paper 003 Exp. 2): its largest contact
+/// A scene in which the robot should touch nothing (interactive-force-control paper Exp. 2): its largest contact
 /// against `ε_c`, how well the hand keeps `d_p,d` ahead of the surface, and how far the user's
 /// touches on the arm guide it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -87,7 +87,7 @@ pub struct ContactFreeMetrics {
 /// The hand counts as arrived at `d_p,d` once it is this close to it \[m\].
 pub const DISTANCE_SETTLED_M: f64 = 0.005;
 
-/// Paper 000: the goal and the contact forces against `ε_c`.
+/// Intentional-contact paper: the goal and the contact forces against `ε_c`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct GoalMetrics {
     /// Final goal error within the supervisor's goal tolerance.
@@ -113,7 +113,7 @@ pub struct GoalMetrics {
     pub longest_contact_over_eps_c_s: f64,
 }
 
-/// Paper 003 Table 3: force tracking in the contact phase.
+/// Interactive-force-control paper Table 3: force tracking in the contact phase.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ForceMetrics {
     /// Mean measured hand force over the settled contact phase \[N\].
@@ -125,7 +125,7 @@ pub struct ForceMetrics {
     /// [`CONTACT_SETTLE_S`] after the first touch \[N\] (null: none).
     pub rms_force_error_interaction_n: f64,
     /// RMS of measured − reference force over the whole contact phase from the hand's first
-    /// touch, interactions (and their tail) excluded, no settle window: what paper 003 Table 3
+    /// touch, interactions (and their tail) excluded, no settle window: what interactive-force-control paper Table 3
     /// reports "throughout the experiment" \[N\].
     pub rms_force_error_from_touch_n: f64,
     /// RMS of measured − reference force without interaction from the first cycle at which the
@@ -173,13 +173,9 @@ fn median(mut v: Vec<f64>) -> f64 {
 /// The metrics of `record`, a run of `scene`.
 pub fn compute(record: &RunRecord, scene: &Scene, limits: Limits) -> Metrics {
     let cycles = &record.cycles;
-    let arm: Vec<usize> = (0..record.joint_names.len())
-        .filter(|&j| !BASE_JOINTS.contains(&record.joint_names[j].as_str()))
-        .collect();
-    let max_joint_speed = cycles
-        .iter()
-        .flat_map(|c| arm.iter().map(move |&j| c.qd[j].abs()))
-        .fold(0.0, f64::max);
+    let arm: Vec<usize> =
+        (0..record.joint_names.len()).filter(|&j| !BASE_JOINTS.contains(&record.joint_names[j].as_str())).collect();
+    let max_joint_speed = cycles.iter().flat_map(|c| arm.iter().map(move |&j| c.qd[j].abs())).fold(0.0, f64::max);
     let sim = record.sim_duration_s();
     Metrics {
         scenario: record.name.clone(),
@@ -190,11 +186,7 @@ pub fn compute(record: &RunRecord, scene: &Scene, limits: Limits) -> Metrics {
         arrangement_switches: record
             .switches
             .iter()
-            .map(|s| SwitchEntry {
-                t: s.t_s,
-                from: mode_name(s.from),
-                to: mode_name(s.to),
-            })
+            .map(|s| SwitchEntry { t: s.t_s, from: mode_name(s.from), to: mode_name(s.to) })
             .collect(),
         faulted_cycles: cycles.iter().filter(|c| c.fault.is_some()).count(),
         goal: (!scene.spec.goals.is_empty()).then(|| goal_metrics(cycles, scene, limits)),
@@ -259,13 +251,8 @@ pub fn longest_over(cycles: &[CycleRecord], limit: f64) -> f64 {
 
 fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: Limits) -> GoalMetrics {
     let eps = limits.eps_c_n;
-    let pushes: Vec<(f64, f64)> = scene
-        .spec
-        .pushes
-        .iter()
-        .filter(|p| p.object.is_some())
-        .map(|p| (p.start_s, p.end_s))
-        .collect();
+    let pushes: Vec<(f64, f64)> =
+        scene.spec.pushes.iter().filter(|p| p.object.is_some()).map(|p| (p.start_s, p.end_s)).collect();
     let excused = |t: f64| pushes.iter().any(|&(a, b)| t >= a && t < b + RECOVERY_LIMIT_S);
     let recovery = pushes
         .iter()
@@ -280,7 +267,9 @@ fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: Limits) -> GoalMe
         goal_reached: error <= limits.goal_tolerance_m,
         goal_error_m: error,
         goal_tolerance_m: limits.goal_tolerance_m,
-        max_contact_force_intentional_n: max_link_force(cycles, |c| c.mode == Mode::IntentionalContact && !excused(c.t_s)),
+        max_contact_force_intentional_n: max_link_force(cycles, |c| {
+            c.mode == Mode::IntentionalContact && !excused(c.t_s)
+        }),
         max_contact_force_n: max_link_force(cycles, |c| !excused(c.t_s)),
         eps_c_n: eps,
         hard_contact_recovery_s: recovery,
@@ -314,7 +303,8 @@ fn force_metrics(cycles: &[CycleRecord]) -> ForceMetrics {
     let (during, n1) = rms(errors(true, true));
     let (from_touch, _) = rms(errors(false, false));
     let reached = phase.iter().find(|p| p.0.hand_force_n >= p.0.force_reference_n).map_or(f64::NAN, |p| p.0.t_s);
-    let (from_reach, _) = rms(phase.iter().filter(|p| !p.1 && p.0.t_s >= reached).map(|p| p.0.hand_force_n - p.0.force_reference_n));
+    let (from_reach, _) =
+        rms(phase.iter().filter(|p| !p.1 && p.0.t_s >= reached).map(|p| p.0.hand_force_n - p.0.force_reference_n));
     let settled: Vec<&CycleRecord> = phase.iter().filter(|p| p.2).map(|p| p.0).collect();
     let n = settled.len() as f64;
     let touch: Vec<&CycleRecord> = phase.iter().map(|p| p.0).collect();
@@ -369,7 +359,12 @@ mod tests {
             mode: Mode::Contact,
             blend: 0.0,
             fusion_weight: 1.0,
-            signals: SupervisorInput { ee_speed_mps: 0.0, avoidance_force_n: 0.0, contact_force_n: 0.0, goal_error_m: 0.0 },
+            signals: SupervisorInput {
+                ee_speed_mps: 0.0,
+                avoidance_force_n: 0.0,
+                contact_force_n: 0.0,
+                goal_error_m: 0.0,
+            },
             torque_norm: 0.0,
             hand_force_n: force,
             link_force_n: force,
@@ -411,7 +406,8 @@ mod tests {
     #[test]
     fn longest_event_over_a_limit_spans_consecutive_cycles() {
         let forces = [0.0, 6.0, 6.0, 6.0, 1.0, 6.0, 0.0, 6.0, 6.0];
-        let cycles: Vec<CycleRecord> = forces.iter().enumerate().map(|(k, &f)| cycle(0.1 * k as f64, f, 0.0, false)).collect();
+        let cycles: Vec<CycleRecord> =
+            forces.iter().enumerate().map(|(k, &f)| cycle(0.1 * k as f64, f, 0.0, false)).collect();
         assert!((longest_over(&cycles, 5.0) - 0.3).abs() < 1e-9);
         assert_eq!(longest_over(&cycles[..1], 5.0), 0.0);
     }

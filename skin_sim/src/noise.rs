@@ -14,10 +14,7 @@ impl Noise {
     /// A generator from `seed`; `stream` separates the sensors of one run (same seed, other
     /// sequence), so adding a sensor does not change another's noise.
     pub fn new(seed: u64, stream: u64) -> Self {
-        Noise {
-            state: seed ^ stream.wrapping_mul(0xD1B5_4A32_D192_ED03),
-            spare: None,
-        }
+        Noise { state: seed ^ stream.wrapping_mul(0xD1B5_4A32_D192_ED03), spare: None }
     }
 
     fn next_u64(&mut self) -> u64 {

@@ -1,4 +1,4 @@
-//! The outcome checks of a run (the "done when"): each a named pass/fail with the measured
+//! The outcome checks of a run (what the scenario must show): each a named pass/fail with the measured
 //! number and its limit.
 
 use crate::metrics::{Metrics, FORCE_RISE_LIMIT_S, RECOVERY_LIMIT_S};
@@ -25,11 +25,7 @@ fn at_most(name: &'static str, value: f64, limit: f64, unit: &str) -> Check {
 }
 
 fn at_least(name: &'static str, value: f64, limit: f64, unit: &str) -> Check {
-    Check {
-        name,
-        detail: format!("{value:.3} {unit} (at least {limit} {unit})"),
-        passed: value >= limit,
-    }
+    Check { name, detail: format!("{value:.3} {unit} (at least {limit} {unit})"), passed: value >= limit }
 }
 
 /// Largest RMS error of the hand's distance to the surface against `d_p,d` in a guidance scene
@@ -43,10 +39,10 @@ pub const GUIDED_MIN_M: f64 = 0.05;
 /// contact phase starts without an impact.
 pub const FIRST_CONTACT_OVERSHOOT_N: f64 = 2.0;
 
-/// The checks of a run: no faulted cycle; paper 000 scenes: goal reached, every contact at most
-/// `ε_c` outside the pushes, pushes relieved within [`RECOVERY_LIMIT_S`]; paper 003 scenes with
+/// The checks of a run: no faulted cycle; intentional-contact paper scenes: goal reached, every contact at most
+/// `ε_c` outside the pushes, pushes relieved within [`RECOVERY_LIMIT_S`]; interactive-force-control paper scenes with
 /// `targets`: the RMS force errors of Table 3; scenes with neither goals nor force references
-/// (paper 003 Exp. 2): no link contact above `ε_c`, the hand at `d_p,d` (when it is not 0) and
+/// (interactive-force-control paper Exp. 2): no link contact above `ε_c`, the hand at `d_p,d` (when it is not 0) and
 /// moved by the touches on the arm (when there are some).
 pub fn checks(m: &Metrics, targets: Option<ForceTargets>) -> Vec<Check> {
     let mut out = vec![Check {
@@ -92,7 +88,12 @@ pub fn checks(m: &Metrics, targets: Option<ForceTargets>) -> Vec<Check> {
         });
     }
     if let (Some(f), Some(t)) = (&m.force, targets) {
-        out.push(at_most("RMS force error w/o interaction (from reaching the reference)", f.rms_force_error_from_reach_n, t.rms_without_n, "N"));
+        out.push(at_most(
+            "RMS force error w/o interaction (from reaching the reference)",
+            f.rms_force_error_from_reach_n,
+            t.rms_without_n,
+            "N",
+        ));
         out.push(at_most("RMS force error w/ interaction", f.rms_force_error_interaction_n, t.rms_with_n, "N"));
     }
     out

@@ -10,16 +10,19 @@ use skin_core::supervisor::Mode;
 use nalgebra::{Isometry3, Quaternion as NaQuaternion, Translation3, UnitQuaternion};
 use skin_core::skin::markers::{MarkerAction, MarkerShape, Rgba, SkinMarker};
 
+use crate::plot::{
+    guidance_figure, intervals_where, paper000_figure, paper003_figure, GuidanceSignals, Paper000Signals,
+    Paper003Signals,
+};
+use crate::record::{CycleRecord, RunRecord};
+use crate::report::{MetricsJson, RunOutput, RunReport, SummaryText};
+use crate::view::{View, ODOM_FRAME};
+use crate::world::KeyFrame;
 use skin_bag::msgs::{
-    Arrangement, Clock, ColorRgba, ControllerState, Float64MultiArray, Header, JointState, Marker, MarkerArray, Point, Quaternion, StringMsg, TfMessage,
-    Time, Transform, TransformStamped, Twist, Vector3,
+    Arrangement, Clock, ColorRgba, ControllerState, Float64MultiArray, Header, JointState, Marker, MarkerArray, Point,
+    Quaternion, StringMsg, TfMessage, Time, Transform, TransformStamped, Twist, Vector3,
 };
 use skin_bag::{full_definition, BagWriter, RosMessage, TRANSIENT_LOCAL_QOS};
-use crate::plot::{guidance_figure, intervals_where, paper000_figure, paper003_figure, GuidanceSignals, Paper000Signals, Paper003Signals};
-use crate::record::{CycleRecord, RunRecord};
-use crate::world::KeyFrame;
-use crate::view::{View, ODOM_FRAME};
-use crate::report::{MetricsJson, RunOutput, RunReport, SummaryText};
 
 /// Every product of a run, as `skin_sim run` writes them: `metrics.json`, `summary.txt`,
 /// `figure.png`, `run.mcap`, the rendered key frames.
@@ -50,15 +53,20 @@ impl RunOutput for KeyFrames {
         if self.video {
             command.arg("--video").stderr(std::process::Stdio::inherit());
         }
-        let rendered = command
-            .output()
-            .map_err(|e| format!("python3 {}: {e}", script.display()))
-            .and_then(|o| if o.status.success() { Ok(()) } else { Err(format!("{}: {}", o.status, String::from_utf8_lossy(&o.stderr).trim())) });
+        let rendered = command.output().map_err(|e| format!("python3 {}: {e}", script.display())).and_then(|o| {
+            if o.status.success() {
+                Ok(())
+            } else {
+                Err(format!("{}: {}", o.status, String::from_utf8_lossy(&o.stderr).trim()))
+            }
+        });
         match rendered {
             Ok(()) => Ok(json),
             Err(why) => {
                 let note = dir.join("keyframes.txt");
-                let text = format!("key frames not rendered (the states are in keyframes.json, the scene in scene.xml): {why}\n");
+                let text = format!(
+                    "key frames not rendered (the states are in keyframes.json, the scene in scene.xml): {why}\n"
+                );
                 std::fs::write(&note, text).with_context(|| format!("writing {}", note.display()))?;
                 Ok(note)
             }
@@ -66,8 +74,8 @@ impl RunOutput for KeyFrames {
     }
 }
 
-/// `figure.png`: paper 000's panels (arrangement, ee speed, proximity and contact force, torque)
-/// for a paper 000 scenario, paper 003's force-tracking panels for a scene of paper 003's phases
+/// `figure.png`: intentional-contact paper's panels (arrangement, ee speed, proximity and contact force, torque)
+/// for an intentional-contact paper scenario, interactive-force-control paper's force-tracking panels for a scene of interactive-force-control paper's phases
 /// with force references, its Fig. 6 panels (hand distance, skin moments at the hand, hand and
 /// base positions) for one without (Exp. 2).
 pub struct FigurePng;
@@ -84,14 +92,21 @@ impl RunOutput for FigurePng {
         let t = column(c, |c| c.t_s);
         let interaction: Vec<bool> = c.iter().map(|c| c.interaction).collect();
         let interactions = intervals_where(&t, &interaction);
-        let scene = Path::new(&r.scene_file).file_name().map_or_else(|| r.scene_file.clone(), |f| f.to_string_lossy().into_owned());
+        let scene = Path::new(&r.scene_file)
+            .file_name()
+            .map_or_else(|| r.scene_file.clone(), |f| f.to_string_lossy().into_owned());
         let title = format!("{} (seed {}, {})", r.name, r.seed, scene);
-        // Paper 003's phases (force tracking or the pre-contact approach) or paper 000's Table I.
+        // Interactive-force-control paper's phases (force tracking or the pre-contact approach) or intentional-contact paper's Table I.
         let phases = c.iter().any(|c| matches!(c.mode, Mode::PreContact | Mode::Contact));
-        // a phase scene without force references: paper 003 Exp. 2 (its metrics have d_p,d)
+        // a phase scene without force references: interactive-force-control paper Exp. 2 (its metrics have d_p,d)
         let guidance = report.metrics.contact_free.as_ref().filter(|_| phases);
         let figure = if let Some(g) = guidance {
-            let base = |k: usize| r.joint_names.iter().position(|j| j == BASE_JOINTS[k]).map_or_else(|| vec![f64::NAN; c.len()], |j| column(c, |c| c.q[j]));
+            let base = |k: usize| {
+                r.joint_names
+                    .iter()
+                    .position(|j| j == BASE_JOINTS[k])
+                    .map_or_else(|| vec![f64::NAN; c.len()], |j| column(c, |c| c.q[j]))
+            };
             let hand = |k: usize| column(c, |c| c.hand_position_m[k]);
             let moment = |k: usize| column(c, |c| c.hand_moment[k]);
             let distance = column(c, |c| if c.hand_distance_m.is_finite() { c.hand_distance_m } else { f64::NAN });
@@ -199,7 +214,13 @@ fn marker_msg(m: &SkinMarker, stamp: Time) -> Marker {
         MarkerAction::Delete => Marker::DELETE,
         MarkerAction::Add => Marker::ADD,
     };
-    let mut out = Marker { header: Header { stamp, frame_id: String::new() }, ns: m.ns.to_string(), id: m.id, action, ..Default::default() };
+    let mut out = Marker {
+        header: Header { stamp, frame_id: String::new() },
+        ns: m.ns.to_string(),
+        id: m.id,
+        action,
+        ..Default::default()
+    };
     if m.action == MarkerAction::Add {
         out.type_ = match m.shape {
             MarkerShape::SphereList => Marker::SPHERE_LIST,
@@ -238,7 +259,11 @@ fn write_view_frame(bag: &mut BagWriter, view: &View, f: &KeyFrame) -> anyhow::R
     let (ns, stamp) = (nanos(f.t_s), Time::from_nanos(nanos(f.t_s)));
     bag.write("/tf", ns, &tf_message(view, f, stamp))?;
     if !f.markers.is_empty() {
-        bag.write("/skin/markers", ns, &MarkerArray { markers: f.markers.iter().map(|m| marker_msg(m, stamp)).collect() })?;
+        bag.write(
+            "/skin/markers",
+            ns,
+            &MarkerArray { markers: f.markers.iter().map(|m| marker_msg(m, stamp)).collect() },
+        )?;
     }
     Ok(())
 }
@@ -256,7 +281,12 @@ impl RunOutput for RunBag {
             bag.write("/supervisor/arrangement", nanos(first.t_s), &arrangement_msg(first.mode, first.t_s))?;
         }
         let view = &r.view;
-        bag.add_topic("/robot_description", StringMsg::TYPE_NAME, &full_definition(StringMsg::TYPE_NAME).map_err(anyhow::Error::msg)?, TRANSIENT_LOCAL_QOS)?;
+        bag.add_topic(
+            "/robot_description",
+            StringMsg::TYPE_NAME,
+            &full_definition(StringMsg::TYPE_NAME).map_err(anyhow::Error::msg)?,
+            TRANSIENT_LOCAL_QOS,
+        )?;
         bag.write("/robot_description", 0, &StringMsg { data: view.robot_description.clone() })?;
         let mut frames = view.frames.iter().peekable();
         let mut switches = r.switches.iter().peekable();
@@ -275,12 +305,14 @@ impl RunOutput for RunBag {
             };
             bag.write("/joint_states", ns, &joints)?;
             for topic in &distinct {
-                let data = topics.iter().zip(&c.joint_velocities).filter(|(t, _)| *t == topic).map(|(_, v)| *v).collect();
+                let data =
+                    topics.iter().zip(&c.joint_velocities).filter(|(t, _)| *t == topic).map(|(_, v)| *v).collect();
                 bag.write(topic, ns, &Float64MultiArray { data, ..Default::default() })?;
             }
             if has_base {
                 let [vx, vy, wz] = c.base_twist;
-                let twist = Twist { linear: Vector3 { x: vx, y: vy, z: 0.0 }, angular: Vector3 { x: 0.0, y: 0.0, z: wz } };
+                let twist =
+                    Twist { linear: Vector3 { x: vx, y: vy, z: 0.0 }, angular: Vector3 { x: 0.0, y: 0.0, z: wz } };
                 bag.write("/base/cmd_vel", ns, &twist)?;
             }
             let s = &c.signals;

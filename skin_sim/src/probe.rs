@@ -1,6 +1,6 @@
-//! Ground truth from MuJoCo, not from the skin: the force pressing on the hand (paper 003's `f_c`
-//! in newtons), the largest force on one robot link (paper 000's `‖F_c‖` against `ε_c`), and where
-//! the hand is (its position and its distance `d_p` to the surface ahead of the palm, paper 003
+//! Ground truth from MuJoCo, not from the skin: the force pressing on the hand (interactive-force-control paper's `f_c`
+//! in newtons), the largest force on one robot link (intentional-contact paper's `‖F_c‖` against `ε_c`), and where
+//! the hand is (its position and its distance `d_p` to the surface ahead of the palm, interactive-force-control paper
 //! Fig. 6).
 
 use mujoco_rs::mujoco_c;
@@ -78,7 +78,17 @@ impl ContactProbe {
         let mut geom = [-1i32];
         // SAFETY: model and data belong together; the arrays have mj_ray's sizes (3, 3, mjNGROUP, 1), no normal wanted.
         let distance = unsafe {
-            mujoco_c::mj_ray(model.ffi(), data.ffi(), &pnt, &vec, SENSED_GROUPS.as_ptr(), true, -1, geom.as_mut_ptr(), std::ptr::null_mut())
+            mujoco_c::mj_ray(
+                model.ffi(),
+                data.ffi(),
+                &pnt,
+                &vec,
+                SENSED_GROUPS.as_ptr(),
+                true,
+                -1,
+                geom.as_mut_ptr(),
+                std::ptr::null_mut(),
+            )
         };
         ProbeReadings {
             hand_n,

@@ -44,7 +44,9 @@ impl ProximityRays {
             SENSED_GROUPS[layer] != 0 && alpha != 0.0
         };
         let geoms: Vec<usize> = (0..mj.ffi().ngeom as usize).filter(|&g| sensed(g)).collect();
-        let primitive = |g: &usize| !matches!(kind[*g], MjtGeomBase::mjGEOM_MESH | MjtGeomBase::mjGEOM_HFIELD | MjtGeomBase::mjGEOM_SDF);
+        let primitive = |g: &usize| {
+            !matches!(kind[*g], MjtGeomBase::mjGEOM_MESH | MjtGeomBase::mjGEOM_HFIELD | MjtGeomBase::mjGEOM_SDF)
+        };
         if geoms.iter().all(primitive) {
             ProximityRays::Culled { near: Vec::with_capacity(geoms.len()), geoms, range_m }
         } else {
@@ -89,7 +91,8 @@ impl ProximityRays {
             ProximityRays::Culled { near, range_m, .. } => (near, *range_m),
         };
         let model = data.model();
-        let (xpos, xmat, size, kind, rbound) = (data.geom_xpos(), data.geom_xmat(), model.geom_size(), model.geom_type(), model.geom_rbound());
+        let (xpos, xmat, size, kind, rbound) =
+            (data.geom_xpos(), data.geom_xmat(), model.geom_size(), model.geom_type(), model.geom_rbound());
         let mut nearest: Option<f64> = None;
         for &g in geoms {
             let near = if kind[g] == MjtGeomBase::mjGEOM_PLANE {
@@ -112,7 +115,13 @@ impl ProximityRays {
 
 /// Whether the end `p + length n` of the segment is not in front of the plane through `origin`
 /// with unit normal `normal` (else the segment cannot cross it from front to back).
-fn segment_end_behind_plane(p: Point3<f64>, n: Vector3<f64>, length: f64, origin: Point3<f64>, normal: Vector3<f64>) -> bool {
+fn segment_end_behind_plane(
+    p: Point3<f64>,
+    n: Vector3<f64>,
+    length: f64,
+    origin: Point3<f64>,
+    normal: Vector3<f64>,
+) -> bool {
     (p + n * length - origin).dot(&normal) <= 0.0
 }
 

@@ -2,8 +2,8 @@
 //! arrangement switches, everything the metrics, the summary, the plots (`skin_sim::plot`) and the
 //! bag writer (the `skin_bag` crate) read. Plain data; nothing in it is computed twice.
 
-use skin_core::supervisor::{Mode, SupervisorInput};
 use crate::world::KeyFrame;
+use skin_core::supervisor::{Mode, SupervisorInput};
 
 use crate::view::View;
 
@@ -22,18 +22,18 @@ pub struct CycleRecord {
     /// Commanded base twist `(vx, vy, wz)` in the base frame (a scene's base motion is the
     /// controller's reference, so it is in here, not added to it).
     pub base_twist: [f64; 3],
-    /// Active arrangement (paper 000 Table I / paper 003 Table 1).
+    /// Active arrangement (intentional-contact paper Table I / interactive-force-control paper Table 1).
     pub mode: Mode,
-    /// `χ` of paper 000 eq. (10)-(11), 0 outside a blend.
+    /// `χ` of intentional-contact paper eq. (10)-(11), 0 outside a blend.
     pub blend: f64,
-    /// Fusion weight `w(t)` of paper 003 eq. (6) the skin was fused with.
+    /// Fusion weight `w(t)` of interactive-force-control paper eq. (6) the skin was fused with.
     pub fusion_weight: f64,
     /// The supervisor's signals: ee speed, `‖F_d‖`, skin contact force `‖F_c‖`, goal error.
     pub signals: SupervisorInput,
     /// `‖τ*‖` \[N m\].
     pub torque_norm: f64,
     /// Normal force of the environment pressing on the hand along its z axis, from MuJoCo's
-    /// contacts \[N\] (paper 003's contact force `f_c`, measured physically).
+    /// contacts \[N\] (interactive-force-control paper's contact force `f_c`, measured physically).
     pub hand_force_n: f64,
     /// Largest total normal contact force of the environment on one robot link, from MuJoCo
     /// \[N\] (the physical counterpart of the skin's `‖F_c‖`).
@@ -43,7 +43,7 @@ pub struct CycleRecord {
     /// Distance ahead of the palm (along `+z_h`) to the first object or person, from MuJoCo \[m\]
     /// (infinite: nothing ahead).
     pub hand_distance_m: f64,
-    /// `ʰΓ`, the hand skin's moment in the hand frame that the controller computed (paper 003
+    /// `ʰΓ`, the hand skin's moment in the hand frame that the controller computed (interactive-force-control paper
     /// eq. 10; normalized-signal units times metres); NaN when the controller ran elsewhere (the ROS
     /// graph does not publish it).
     pub hand_moment: [f64; 3],
@@ -91,9 +91,9 @@ pub struct RunRecord {
     pub timestep_s: f64,
     /// Seed of the sensor noise.
     pub seed: u64,
-    /// The supervisor's speed threshold `ε_v` \[m/s\] (paper 000 Table I).
+    /// The supervisor's speed threshold `ε_v` \[m/s\] (intentional-contact paper Table I).
     pub eps_v_mps: f64,
-    /// The supervisor's contact force limit `ε_c` \[N\] (paper 000 Table I).
+    /// The supervisor's contact force limit `ε_c` \[N\] (intentional-contact paper Table I).
     pub eps_c_n: f64,
     /// One entry per control cycle, in time order.
     pub cycles: Vec<CycleRecord>,

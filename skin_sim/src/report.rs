@@ -39,7 +39,8 @@ impl RunReport {
             m.sim_duration_s, self.record.wall_time_s, m.realtime_factor, m.control_cycle_us_p50
         );
         let _ = writeln!(s, "  max arm joint speed {:.3} rad/s", m.max_joint_speed_rad_s);
-        let switches: Vec<String> = m.arrangement_switches.iter().map(|w| format!("{:.2} s {} -> {}", w.t, w.from, w.to)).collect();
+        let switches: Vec<String> =
+            m.arrangement_switches.iter().map(|w| format!("{:.2} s {} -> {}", w.t, w.from, w.to)).collect();
         let _ = writeln!(s, "  arrangement switches ({}): {}", switches.len(), switches.join(", "));
         if let Some(g) = &m.goal {
             let _ = writeln!(

@@ -9,7 +9,6 @@ use skin_core::controller::ControllerConfig;
 use skin_core::supervisor::{Mode, SupervisorInput};
 
 use crate::closed_loop::{ClosedLoop, LoopError};
-use skin_core::controller::HandForceMap;
 use crate::interaction::Interactions;
 use crate::metrics::{self, Limits};
 use crate::outcome;
@@ -19,6 +18,7 @@ use crate::report::RunReport;
 use crate::scenario::{self, ForceTargets, Scenario};
 use crate::scene::{RunOverrides, Scene};
 use crate::view::ViewRecorder;
+use skin_core::controller::HandForceMap;
 
 /// What to run: a scene, the controller setup for it, the targets it is judged on.
 #[derive(Debug, Clone, PartialEq)]
@@ -29,7 +29,7 @@ pub struct RunTarget {
     pub scene: PathBuf,
     /// Controller setup file.
     pub controller: PathBuf,
-    /// Paper 003 Table 3 targets, if any.
+    /// Interactive-force-control paper Table 3 targets, if any.
     pub force_targets: Option<ForceTargets>,
 }
 

@@ -1,7 +1,7 @@
 //! What the scene tells the controller over time: the active end-effector goal (`goals`), the
 //! force reference (`force_references`, newtons turned into the hand signal by
-//! [`HandForceMap`]), the commanded base motion (`base_motions`, [`BaseMotions`]) and, for paper 003's phase policy, the switch to the contact phase when
-//! the first force reference starts (paper 003 Sec. 4.2.2: "the contact phase is manually
+//! [`HandForceMap`]), the commanded base motion (`base_motions`, [`BaseMotions`]) and, for interactive-force-control paper's phase policy, the switch to the contact phase when
+//! the first force reference starts (interactive-force-control paper Sec. 4.2.2: "the contact phase is manually
 //! activated by the user"; the scene's `start_s` is that moment).
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
@@ -9,8 +9,8 @@ use skin_core::controller::{Controller, Fault};
 use skin_core::supervisor::{Phase, Policy};
 
 use crate::base_motion::BaseMotions;
-use skin_core::controller::HandForceMap;
 use crate::scene::{ForceReferenceSpec, GoalSpec, Scene};
+use skin_core::controller::HandForceMap;
 
 /// A scene input the controller cannot take.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -33,10 +33,7 @@ pub struct ScheduledInputs {
 
 impl ScheduledInputs {
     /// No force reference.
-    pub const NONE: ScheduledInputs = ScheduledInputs {
-        force_n: f64::NAN,
-        force_signal: f64::NAN,
-    };
+    pub const NONE: ScheduledInputs = ScheduledInputs { force_n: f64::NAN, force_signal: f64::NAN };
 }
 
 /// Goals, force references and the phase plan of a scene, applied to a controller by time.
@@ -48,7 +45,7 @@ pub struct Schedule {
     motions: BaseMotions,
     /// Model indices of the base joints (x, y, yaw) when the scene's base moves.
     base: Option<[usize; 3]>,
-    /// Start of the contact phase (paper 003 policy with force references).
+    /// Start of the contact phase (interactive-force-control paper policy with force references).
     contact_from_s: Option<f64>,
     /// Index of the goal last given to the controller.
     active_goal: Option<usize>,
@@ -83,10 +80,12 @@ impl Schedule {
         if !forces.is_empty() {
             let reject = |reason: &str| ScheduleError { key: "force_references".into(), reason: reason.into() };
             if controller.supervisor().policy() != Policy::Phases {
-                return Err(reject("need a controller with `policy: phases` (paper 003 Table 1)"));
+                return Err(reject("need a controller with `policy: phases` (interactive-force-control paper Table 1)"));
             }
             if map.is_none() {
-                return Err(reject("the controller's hand_patches have no cell facing along the end effector's z axis"));
+                return Err(reject(
+                    "the controller's hand_patches have no cell facing along the end effector's z axis",
+                ));
             }
         }
         let contact_from_s = match controller.supervisor().policy() {
@@ -141,10 +140,8 @@ impl Schedule {
 }
 
 /// The goal pose; identity orientation when the goal gives none (only `goal_orientation` reads
-/// it, and paper 000's arrangements do not use that task).
+/// it, and intentional-contact paper's arrangements do not use that task).
 fn goal_pose(g: &GoalSpec) -> Isometry3<f64> {
-    let rotation = g
-        .rpy
-        .map_or(UnitQuaternion::identity(), |[r, p, y]| UnitQuaternion::from_euler_angles(r, p, y));
+    let rotation = g.rpy.map_or(UnitQuaternion::identity(), |[r, p, y]| UnitQuaternion::from_euler_angles(r, p, y));
     Isometry3::from_parts(Translation3::from(Vector3::from(g.position_m)), rotation)
 }

@@ -1,6 +1,6 @@
 //! Simulated skin: per cell, the proximity sensor as a ray along the cell's outward normal and
 //! the three force sensors from the MuJoCo contacts near the cell, both through the cell
-//! characteristics of `config/skin_model.yaml` (paper 003 Sec. 2.3: normalized, nonlinear).
+//! characteristics of `config/skin_model.yaml` (interactive-force-control paper Sec. 2.3: normalized, nonlinear).
 //!
 //! - Proximity: a ray from the cell's world position along its outward normal, testing only
 //!   objects and persons (`crate::mjcf::SENSED_GROUPS`: the robot never sees itself) near the
@@ -151,7 +151,8 @@ impl SkinSensor {
                 start..end
             })
             .collect::<Vec<_>>();
-        let body_sphere = body_range.iter().map(|r| bounding_sphere(by_body[r.clone()].iter().map(|&i| cells[i].position))).collect();
+        let body_sphere =
+            body_range.iter().map(|r| bounding_sphere(by_body[r.clone()].iter().map(|&i| cells[i].position))).collect();
         let n = cells.len();
         Some(SkinSensor {
             cells,
@@ -199,10 +200,7 @@ impl SkinSensor {
             let f = self.force_n[i];
             let p = if f > 0.0 { 1.0 } else { self.distance_m[i].map_or(0.0, |d| self.proximity.signal(d)) };
             let force = self.force.signal(f);
-            let mut reading = CellReading {
-                force: [force; 3],
-                proximity: p,
-            };
+            let mut reading = CellReading { force: [force; 3], proximity: p };
             for s in &mut reading.force {
                 *s = (*s + self.noise.gaussian(self.force_noise_std)).clamp(0.0, 1.0);
             }
@@ -266,7 +264,13 @@ impl SkinSensor {
                         p.min = p.min.inf(&pos);
                         p.max = p.max.sup(&pos);
                     }
-                    None => self.patches.push(ContactPatch { geoms: [g, other], body: geom_body[g] as usize, force: f, min: pos, max: pos }),
+                    None => self.patches.push(ContactPatch {
+                        geoms: [g, other],
+                        body: geom_body[g] as usize,
+                        force: f,
+                        min: pos,
+                        max: pos,
+                    }),
                 }
             }
         }
@@ -290,7 +294,13 @@ impl SkinSensor {
         let Some(u) = local_f.try_normalize(0.0) else { return };
         let facing = |c: &SimCell| -u.dot(&c.normal);
         let cells = &self.cells;
-        let compression = |i: usize| if facing(&cells[i]) > 0.0 { cells[i].face.compression(data, &pose, patch.geoms[1]) } else { 0.0 };
+        let compression = |i: usize| {
+            if facing(&cells[i]) > 0.0 {
+                cells[i].face.compression(data, &pose, patch.geoms[1])
+            } else {
+                0.0
+            }
+        };
         self.weights.clear();
         self.weights.extend(self.by_body[range.clone()].iter().map(|&i| compression(i)));
         if self.weights.iter().sum::<f64>() <= 0.0 {
@@ -318,7 +328,11 @@ impl SkinSensor {
             let along = d.dot(&u);
             let off_line = (d - u * along).norm();
             // before the point along the force (where it comes from), facing it
-            if along > 0.0 { 0.0 } else { (1.0 - off_line / TOUCH_RADIUS_M).max(0.0) * (-u.dot(&c.normal)).max(0.0) }
+            if along > 0.0 {
+                0.0
+            } else {
+                (1.0 - off_line / TOUCH_RADIUS_M).max(0.0) * (-u.dot(&c.normal)).max(0.0)
+            }
         };
         self.weights.clear();
         self.weights.extend(self.by_body[range.clone()].iter().map(|&i| weight(&self.cells[i])));
@@ -330,7 +344,11 @@ impl SkinSensor {
     fn share(&mut self, range: Range<usize>, magnitude: f64, facing: impl Fn(&SimCell) -> f64) {
         // Nearly tangential cells count as MIN_FACING: the cover carries the rest in shear.
         let cells = &self.cells;
-        let balance: f64 = self.by_body[range.clone()].iter().zip(&self.weights).map(|(&i, w)| w * facing(&cells[i]).max(MIN_FACING)).sum();
+        let balance: f64 = self.by_body[range.clone()]
+            .iter()
+            .zip(&self.weights)
+            .map(|(&i, w)| w * facing(&cells[i]).max(MIN_FACING))
+            .sum();
         if balance <= 0.0 {
             return; // no skin there facing the force
         }
@@ -351,7 +369,8 @@ mod tests {
     /// arm sweeps past obstacles.
     #[test]
     fn the_body_culled_rays_read_what_each_cell_reads_alone() {
-        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/scenes/tomm_movable_obstacles.yaml");
+        let file =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/scenes/tomm_movable_obstacles.yaml");
         let mut world = World::from_scene_file(&file).unwrap();
         let (mut hits, mut culled) = (0, 0);
         for _ in 0..6 {
@@ -366,7 +385,11 @@ mod tests {
                 let (p, n) = sensor.cell_world(&data, i);
                 let alone = sensor.rays.select_near(&data, p, 0.0);
                 let in_contact = sensor.force_n[i] > 0.0;
-                let expected = if sensor.cells[i].active && !in_contact && alone { sensor.rays.cast(&mut data, p, n) } else { None };
+                let expected = if sensor.cells[i].active && !in_contact && alone {
+                    sensor.rays.cast(&mut data, p, n)
+                } else {
+                    None
+                };
                 assert_eq!(sensor.distance_m[i], expected, "cell {i}");
                 hits += usize::from(expected.is_some());
                 culled += usize::from(!alone);

@@ -14,9 +14,9 @@ use skin_core::skin::markers::SkinMarkers;
 use skin_core::supervisor::Mode;
 
 use crate::record::{mode_name, MAX_KEY_FRAMES};
-use crate::world::KeyFrame;
 use crate::scene::spec::{GoalSpec, ViewSpec};
 use crate::scene::Scene;
+use crate::world::KeyFrame;
 use crate::world::World;
 
 /// The TF frame the robot's tree hangs from: the world of the simulation, which is the
@@ -77,7 +77,8 @@ pub fn pose_array(p: &Isometry3<f64>) -> [f64; 7] {
 /// base's planar joints become one transform `odom -> base_link`: the links they move before
 /// the yaw joint (`base_x_link`, `base_y_link`) are left out.
 pub fn tf_tree(model: &RobotModel) -> (Vec<usize>, Vec<Option<usize>>) {
-    let virtual_links: Vec<usize> = BASE_JOINTS[..2].iter().filter_map(|n| model.joint_index(n)).map(|j| model.joint_child_frame(j)).collect();
+    let virtual_links: Vec<usize> =
+        BASE_JOINTS[..2].iter().filter_map(|n| model.joint_index(n)).map(|j| model.joint_child_frame(j)).collect();
     let frames: Vec<usize> = (0..model.nframes()).filter(|f| !virtual_links.contains(f)).collect();
     let index = |f: usize| frames.iter().position(|&g| g == f);
     let parents = frames
@@ -129,7 +130,11 @@ impl ViewRecorder {
                     .layout
                     .patches()
                     .iter()
-                    .flat_map(|p| config.layout.cells()[p.cells.clone()].iter().map(|c| CellSite { link: p.link.clone(), position: c.position_link.into() }))
+                    .flat_map(|p| {
+                        config.layout.cells()[p.cells.clone()]
+                            .iter()
+                            .map(|c| CellSite { link: p.link.clone(), position: c.position_link.into() })
+                    })
                     .collect(),
                 frames: Vec::new(),
             },
@@ -150,7 +155,8 @@ impl ViewRecorder {
         let label = event.filter(|_| self.labelled + 1 < MAX_KEY_FRAMES);
         self.capture(world, mode, label.unwrap_or_default());
         if due {
-            self.next_s += self.period_s * ((world.time() - self.next_s) / self.period_s).floor().max(0.0) + self.period_s;
+            self.next_s +=
+                self.period_s * ((world.time() - self.next_s) / self.period_s).floor().max(0.0) + self.period_s;
         }
     }
 
@@ -163,7 +169,8 @@ impl ViewRecorder {
     fn capture(&mut self, world: &World, mode: Mode, label: String) {
         self.labelled += usize::from(!label.is_empty());
         let q = world.q();
-        update_kinematics(&self.model, &mut self.data, q, &vec![0.0; q.len()]).expect("the world's joints are the model's");
+        update_kinematics(&self.model, &mut self.data, q, &vec![0.0; q.len()])
+            .expect("the world's joints are the model's");
         let readings = world.skin_readings();
         let mut markers = Vec::new();
         if readings.len() == self.layout.num_cells() {

@@ -159,10 +159,7 @@ impl World {
         quiet_mujoco_log();
         let file = scene.file.clone();
         let xml = scene_xml(&scene).map_err(|source| WorldError::Mjcf { file: file.clone(), source })?;
-        let mj = MjModel::from_xml_string(&xml).map_err(|e| WorldError::MuJoCo {
-            file,
-            message: e.to_string(),
-        })?;
+        let mj = MjModel::from_xml_string(&xml).map_err(|e| WorldError::MuJoCo { file, message: e.to_string() })?;
         let model = &scene.model;
         let body = |name: &str| mj.name_to_id(MjtObjBase::mjOBJ_BODY, name).expect("generated body");
         let joints = (0..model.nv())
@@ -176,9 +173,7 @@ impl World {
                 })
             })
             .collect();
-        let arm = (0..model.nv())
-            .filter(|&j| !BASE_JOINTS.contains(&model.joint_names()[j].as_str()))
-            .collect();
+        let arm = (0..model.nv()).filter(|&j| !BASE_JOINTS.contains(&model.joint_names()[j].as_str())).collect();
         let pushes = scene
             .spec
             .pushes
@@ -202,12 +197,7 @@ impl World {
                 }
             })
             .collect();
-        let persons = scene
-            .spec
-            .persons
-            .iter()
-            .map(|p| mj.body_mocapid()[body(&p.name)] as usize)
-            .collect();
+        let persons = scene.spec.persons.iter().map(|p| mj.body_mocapid()[body(&p.name)] as usize).collect();
         let skin = SkinSensor::new(&scene, &mj);
         let lidar = Lidar::new(&scene, &mj);
         let spec = &scene.spec;
@@ -255,7 +245,13 @@ impl World {
 
     /// The current MuJoCo state as a key frame labelled `label` (no poses, no markers).
     pub fn key_frame(&self, label: String) -> KeyFrame {
-        KeyFrame { t_s: self.time(), label, qpos: self.data.qpos().to_vec(), mocap_pos: self.data.mocap_pos().to_vec(), ..KeyFrame::default() }
+        KeyFrame {
+            t_s: self.time(),
+            label,
+            qpos: self.data.qpos().to_vec(),
+            mocap_pos: self.data.mocap_pos().to_vec(),
+            ..KeyFrame::default()
+        }
     }
 
     /// The generated MJCF of the world.
@@ -293,10 +289,7 @@ impl World {
     /// to the URDF velocity limits. Held until the next call.
     pub fn set_arm_velocity_commands(&mut self, qd: &[f64]) -> Result<(), WorldError> {
         if qd.len() != self.arm.len() {
-            return Err(WorldError::CommandLength {
-                expected: self.arm.len(),
-                got: qd.len(),
-            });
+            return Err(WorldError::CommandLength { expected: self.arm.len(), got: qd.len() });
         }
         for (&j, &v) in self.arm.iter().zip(qd) {
             if let Some(io) = self.joints[j] {

@@ -1,11 +1,11 @@
 //! The closed loop with the real controller: determinism, metrics.json keys, every scenario's
 //! setup, and the outcome checks that hold today (see docs/scenarios.md).
 
-use skin_core::model::{update_kinematics, ModelData};
 use skin_core::controller::HandForceMap;
+use skin_core::model::{update_kinematics, ModelData};
+use skin_core::supervisor::Mode;
 use skin_sim::runner::RunTarget;
 use skin_sim::scenario::{self, SCENARIOS};
-use skin_core::supervisor::Mode;
 use skin_sim::scene::RunOverrides;
 
 fn run(name: &str, seconds: f64) -> skin_sim::report::RunReport {
@@ -30,8 +30,16 @@ fn same_seed_gives_a_bit_identical_record() {
 
 #[test]
 fn metrics_json_has_the_keys_of_each_paper() {
-    let always = ["realtime_factor", "sim_duration_s", "max_joint_speed_rad_s", "control_cycle_us_p50", "arrangement_switches"];
-    let paper000 = ["goal_reached", "goal_error_m", "max_contact_force_intentional_n", "eps_c_n", "hard_contact_recovery_s", "longest_contact_over_eps_c_s"];
+    let always =
+        ["realtime_factor", "sim_duration_s", "max_joint_speed_rad_s", "control_cycle_us_p50", "arrangement_switches"];
+    let paper000 = [
+        "goal_reached",
+        "goal_error_m",
+        "max_contact_force_intentional_n",
+        "eps_c_n",
+        "hard_contact_recovery_s",
+        "longest_contact_over_eps_c_s",
+    ];
     let paper003 = [
         "force_mean_n",
         "rms_force_error_n",
@@ -43,7 +51,11 @@ fn metrics_json_has_the_keys_of_each_paper() {
         "first_contact_reference_n",
     ];
     let contact_free = ["max_link_contact_n", "eps_c_n"];
-    for (name, keys) in [("intentional_contact", &paper000[..]), ("poster_phrc", &paper003[..]), ("tactile_guidance", &contact_free[..])] {
+    for (name, keys) in [
+        ("intentional_contact", &paper000[..]),
+        ("poster_phrc", &paper003[..]),
+        ("tactile_guidance", &contact_free[..]),
+    ] {
         let report = run(name, 0.5);
         let json: serde_json::Value = serde_json::to_value(&report.metrics).unwrap();
         for key in always.iter().chain(keys) {
@@ -57,7 +69,13 @@ fn metrics_json_has_the_keys_of_each_paper() {
 fn every_scenario_builds_and_runs_without_a_safe_stop() {
     for s in &SCENARIOS {
         let report = run(s.name, 0.5);
-        assert_eq!(report.metrics.faulted_cycles, 0, "{}: {:?}", s.name, report.record.cycles.iter().find_map(|c| c.fault.clone()));
+        assert_eq!(
+            report.metrics.faulted_cycles,
+            0,
+            "{}: {:?}",
+            s.name,
+            report.record.cycles.iter().find_map(|c| c.fault.clone())
+        );
         let rate = report.record.control_rate_hz;
         assert_eq!(report.record.cycles.len(), (0.5 * rate).round() as usize, "{}", s.name);
     }
@@ -65,7 +83,7 @@ fn every_scenario_builds_and_runs_without_a_safe_stop() {
 
 #[test]
 fn intentional_contact_passes_every_outcome_check() {
-    // The whole scene (20 s simulated, a few seconds here): paper 000 Figs. 2-3. The arm comes to
+    // The whole scene (20 s simulated, a few seconds here): intentional-contact paper Figs. 2-3. The arm comes to
     // rest at the obstacle (continuous skin-row activation), enters intentional contact, pushes
     // the obstacle below eps_c, reaches the goal and relieves the hard push within 0.5 s.
     let report = passes_paper_000_checks("intentional_contact", 20.0);
@@ -74,19 +92,19 @@ fn intentional_contact_passes_every_outcome_check() {
 
 #[test]
 fn tomm_movable_obstacles_passes_every_outcome_check() {
-    // Paper 000 Fig. 5, the whole scene (30 s): TOMM's right arm stuck at two movable blocks on
+    // Intentional-contact paper Fig. 5, the whole scene (30 s): TOMM's right arm stuck at two movable blocks on
     // the table pushes them aside in intentional contact and reaches the goal.
     passes_paper_000_checks("tomm_movable_obstacles", 30.0);
 }
 
 #[test]
 fn tomm_fixed_obstacle_passes_every_outcome_check() {
-    // Paper 000 Fig. 6, the whole scene (40 s): beside a fixed wall, the movable block on the path
+    // Intentional-contact paper Fig. 6, the whole scene (40 s): beside a fixed wall, the movable block on the path
     // is pushed away in intentional contact; the goal is reached.
     passes_paper_000_checks("tomm_fixed_obstacle", 40.0);
 }
 
-/// Runs a paper 000 scene and asserts its story: stuck first ((a) -> (b)), the arm touches the
+/// Runs an intentional-contact paper scene and asserts its story: stuck first ((a) -> (b)), the arm touches the
 /// obstacle in (b) with at most eps_c, and every outcome check (goal within 1 cm, contacts at
 /// most eps_c outside the pushes, pushes relieved) passes.
 fn passes_paper_000_checks(name: &str, seconds: f64) -> skin_sim::report::RunReport {
@@ -101,19 +119,23 @@ fn passes_paper_000_checks(name: &str, seconds: f64) -> skin_sim::report::RunRep
     }
     let g = report.metrics.goal.as_ref().expect("goal metrics");
     assert!(g.max_contact_force_intentional_n > 0.0, "{name}: the arm touches the obstacle in (b)");
-    assert!(g.max_contact_force_intentional_n <= g.eps_c_n, "{name}: intentional contact at most eps_c: {} N", g.max_contact_force_intentional_n);
+    assert!(
+        g.max_contact_force_intentional_n <= g.eps_c_n,
+        "{name}: intentional contact at most eps_c: {} N",
+        g.max_contact_force_intentional_n
+    );
     report
 }
 
 #[test]
 fn poster_phrc_passes_every_outcome_check() {
-    // The whole scene (80 s simulated): paper 003 Exp. 4, 6 N held on a leaning wall while a
+    // The whole scene (80 s simulated): interactive-force-control paper Exp. 4, 6 N held on a leaning wall while a
     // person pushes the arm; RMS force errors within Table 3's 0.42 N (without) and 0.80 N (with
     // interaction), measured by MuJoCo, not the skin.
     passes_table_3_with_interactions("poster_phrc", 80.0);
 }
 
-/// Runs a paper 003 scene that has interaction periods and asserts every outcome check.
+/// Runs a interactive-force-control paper scene that has interaction periods and asserts every outcome check.
 fn passes_table_3_with_interactions(name: &str, seconds: f64) {
     let report = run(name, seconds);
     assert!(report.checks.iter().any(|c| c.name.contains("w/ interaction")), "the scene has interaction periods");
@@ -124,7 +146,7 @@ fn passes_table_3_with_interactions(name: &str, seconds: f64) {
 
 #[test]
 fn force_tracking_base_motion_meets_table_3_with_and_without_base_motion() {
-    // Paper 003 Exp. 1, the whole scene (90 s, the 4 +- 1 N sine from the contact switch at 5 s,
+    // Interactive-force-control paper Exp. 1, the whole scene (90 s, the 4 +- 1 N sine from the contact switch at 5 s,
     // the base's circle from 15 s and swings from 50 s): the hand stays on the board, the mean is
     // the reference's, both RMS errors (MuJoCo's force) are within Table 3's 0.16 N (without) and
     // 0.37 N (with base motion); the base really moves and the hand stays where it was.
@@ -136,7 +158,11 @@ fn force_tracking_base_motion_meets_table_3_with_and_without_base_motion() {
     let (mean, lost) = (m.force_mean_n, m.contact_lost_fraction);
     assert!((mean - 4.0).abs() < 0.3, "mean force {mean} N, reference mean 4 N");
     assert!(lost < 0.01, "contact lost {lost} of the time");
-    assert!(m.rms_cycles[1] > m.rms_cycles[0], "the base motions (15-90 s) are the \"with\" period: {:?}", m.rms_cycles);
+    assert!(
+        m.rms_cycles[1] > m.rms_cycles[0],
+        "the base motions (15-90 s) are the \"with\" period: {:?}",
+        m.rms_cycles
+    );
     let target = RunTarget::from(scenario::find("force_tracking_base_motion").unwrap());
     let scene = skin_sim::Scene::load(&target.scene).unwrap();
     let (model, base) = (&scene.model, scene.moving_base().expect("the base moves"));
@@ -157,7 +183,7 @@ fn force_tracking_base_motion_meets_table_3_with_and_without_base_motion() {
 
 #[test]
 fn tactile_guidance_passes_every_outcome_check() {
-    // Paper 003 Exp. 2, the whole scene (50 s): the hand approaches the board and holds d_p,d
+    // Interactive-force-control paper Exp. 2, the whole scene (50 s): the hand approaches the board and holds d_p,d
     // = 3 cm (MuJoCo's distance ahead of the palm), touches on the arm (felt by its skin) move
     // it along the board, nothing of the robot presses on anything, a person nears the base.
     let report = run("tactile_guidance", 50.0);
@@ -172,7 +198,7 @@ fn tactile_guidance_passes_every_outcome_check() {
 
 #[test]
 fn force_tracking_interaction_passes_every_outcome_check() {
-    // Paper 003 Exp. 3, the whole scene (90 s): 5 +- 2 N while the arm is pushed and a person
+    // Interactive-force-control paper Exp. 3, the whole scene (90 s): 5 +- 2 N while the arm is pushed and a person
     // nears the base; RMS force errors within Table 3's 0.23 N (without) and 0.58 N (with).
     passes_table_3_with_interactions("force_tracking_interaction", 90.0);
 }

@@ -35,10 +35,12 @@ fn figure_and_bag_of_a_run() {
             .map(|m| m.decode::<Float64MultiArray>().unwrap().data.len())
             .sum();
         assert_eq!(commands, r.cycles.len() * r.arm_joints.len(), "{name}: every arm joint every cycle");
-        let first = messages.iter().find(|m| m.topic == "/supervisor/arrangement").unwrap().decode::<Arrangement>().unwrap();
+        let first =
+            messages.iter().find(|m| m.topic == "/supervisor/arrangement").unwrap().decode::<Arrangement>().unwrap();
         assert_eq!(first.mode, r.cycles[0].mode.as_u8());
         // the view: the robot's description once, per view frame /tf, the markers when they change
-        let description = messages.iter().find(|m| m.topic == "/robot_description").unwrap().decode::<StringMsg>().unwrap();
+        let description =
+            messages.iter().find(|m| m.topic == "/robot_description").unwrap().decode::<StringMsg>().unwrap();
         assert!(description.data.contains("<robot"), "{name}");
         assert_eq!(count("/robot_description"), 1);
         assert_eq!(count("/tf"), r.view.frames.len(), "{name}");
@@ -64,13 +66,18 @@ fn key_frames_are_rendered_or_the_reason_is_written() {
     let dir = std::env::temp_dir().join(format!("skin_sim_keyframes_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = KeyFrames { video: false }.write(&report, &dir).unwrap();
-    let view: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("keyframes.json")).unwrap()).unwrap();
+    let view: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("keyframes.json")).unwrap()).unwrap();
     let frames = view["frames"].as_array().unwrap();
     // 10 fps over 10 s and the switch
     assert_eq!(frames.len(), 102, "frames at the view rate, the switch, the end");
     assert_eq!(frames.iter().filter(|f| f["label"] != "").count(), 3);
     assert!(std::fs::read_to_string(dir.join("scene.xml")).unwrap().contains("<mujoco"));
-    let pngs: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().starts_with("keyframe_")).collect();
+    let pngs: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with("keyframe_"))
+        .collect();
     if file == dir.join("keyframes.json") {
         assert_eq!(pngs.len(), 3, "one picture per key frame");
         for p in &pngs {

@@ -137,7 +137,8 @@ fn scene_errors_name_the_file_and_the_key() {
     assert!(e.contains("`base_motions`") && e.contains("does not move"), "{e}");
     let e = invalid(&planar7("base_motions: [{start_s: 1, end_s: 19, circle: {radius_m: 0.2, period_s: 5}, swing: {amplitude_m: 0.3, period_s: 9, axis: [0, 1]}}]\n"));
     assert!(e.contains("`base_motions[0]`") && e.contains("exactly one"), "{e}");
-    let e = invalid(&planar7("base_motions: [{start_s: 1, end_s: 9, ramp_s: 5, circle: {radius_m: 0.2, period_s: 5}}]\n"));
+    let e =
+        invalid(&planar7("base_motions: [{start_s: 1, end_s: 9, ramp_s: 5, circle: {radius_m: 0.2, period_s: 5}}]\n"));
     assert!(e.contains("`base_motions[0].ramp_s`"), "{e}");
     let e = invalid(&planar7(&format!("base_motions: [{circle}, {{start_s: 20, end_s: 40, swing: {{amplitude_m: 0.3, period_s: 9, axis: [0, 0]}}}}]\n")));
     assert!(e.contains("`base_motions[1].swing.axis`"), "{e}");
@@ -153,10 +154,7 @@ fn scene_errors_name_the_file_and_the_key() {
     assert!(e.contains("`view.elevation_deg`"), "{e}");
     let e = invalid(&planar7("view: {distance_m: -1}\n"));
     assert!(e.contains("`view.distance_m`"), "{e}");
-    assert!(matches!(
-        Scene::from_yaml_str("robot: {urdf: x}\n", "bad.yaml", &scenes_dir()),
-        Err(SceneError::Yaml(_))
-    ));
+    assert!(matches!(Scene::from_yaml_str("robot: {urdf: x}\n", "bad.yaml", &scenes_dir()), Err(SceneError::Yaml(_))));
     // A valid scene text passes.
     scene(&planar7(""));
 }

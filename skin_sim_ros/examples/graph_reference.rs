@@ -9,12 +9,12 @@
 //! `graph_reference --scene intentional_contact --duration 4 --out ref.json`
 use anyhow::{Context as _, Result};
 use clap::Parser;
-use skin_sim_ros::sim_bridge::{run_in_process, SimBridge};
 use skin_control::task_controller::{SupervisorSource, TaskController, TaskControllerParams, Trigger};
 use skin_core::controller::ControllerConfig;
 use skin_sim::closed_loop::ClosedLoop;
 use skin_sim::runner::RunTarget;
 use skin_sim::scene::Scene;
+use skin_sim_ros::sim_bridge::{run_in_process, SimBridge};
 
 #[derive(Parser)]
 #[command(about = "In-process references for the lockstep graph (JSON)")]
@@ -44,7 +44,8 @@ fn main() -> Result<()> {
     params.control_rate_hz = scene.spec.control_rate_hz;
     let cycles = (args.duration * scene.spec.control_rate_hz).round() as usize;
     let mut tc = TaskController::new(config, params.clone(), 0.0).map_err(anyhow::Error::msg)?;
-    let mut bridge = SimBridge::new(scene.clone(), &params.arms.namespaces, &params.arms.joint_prefixes).map_err(anyhow::Error::msg)?;
+    let mut bridge = SimBridge::new(scene.clone(), &params.arms.namespaces, &params.arms.joint_prefixes)
+        .map_err(anyhow::Error::msg)?;
     let commands = run_in_process(&mut bridge, &mut tc, cycles);
     let mut direct = ClosedLoop::new(scene, &target.controller)?;
     let closed: Vec<Vec<f64>> = (0..cycles).map(|_| direct.cycle().joint_velocities.clone()).collect();

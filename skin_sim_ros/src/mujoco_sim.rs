@@ -110,9 +110,12 @@ pub fn scenario_setup(arg: &str) -> Option<PathBuf> {
 pub fn describe(scene: &str, setup: Option<PathBuf>) -> Result<serde_json::Value> {
     let target = RunTarget::resolve(scene, setup).map_err(|e| anyhow::anyhow!("--scene: {e}"))?;
     let loaded = skin_sim::scene::Scene::load(&target.scene).with_context(|| format!("--scene {scene}"))?;
-    let (setup, _) = skin_core::controller::ControllerSetup::load(&target.controller).with_context(|| target.controller.display().to_string())?;
+    let (setup, _) = skin_core::controller::ControllerSetup::load(&target.controller)
+        .with_context(|| target.controller.display().to_string())?;
     let dir = target.controller.parent().unwrap_or(std::path::Path::new("."));
-    let absolute = |p: &std::path::Path| std::fs::canonicalize(p).or_else(|_| std::path::absolute(p)).unwrap_or_else(|_| p.to_path_buf());
+    let absolute = |p: &std::path::Path| {
+        std::fs::canonicalize(p).or_else(|_| std::path::absolute(p)).unwrap_or_else(|_| p.to_path_buf())
+    };
     let arms = ArmsParams::for_joints(loaded.model.joint_names());
     Ok(serde_json::json!({
         "scene": absolute(&target.scene),
@@ -250,9 +253,12 @@ impl SimHandle {
             CLOCK => Some(p.clock.get_inter_process_subscription_count()),
             _ => None,
         };
-        let lacking = skin_control::nodes::lacking_subscribers(&self.options.wait_topic_subscribers, count).map_err(|e| {
-            anyhow::anyhow!("--wait-topic-subscribers: {e} (inputs: {JOINT_STATES}, {CELLS}, {ODOM}, {SCAN}, {CLOCK})")
-        })?;
+        let lacking =
+            skin_control::nodes::lacking_subscribers(&self.options.wait_topic_subscribers, count).map_err(|e| {
+                anyhow::anyhow!(
+                    "--wait-topic-subscribers: {e} (inputs: {JOINT_STATES}, {CELLS}, {ODOM}, {SCAN}, {CLOCK})"
+                )
+            })?;
         if !lacking.is_empty() && self.started.elapsed() > Duration::from_secs(30) {
             r2r::log_warn!(&self.logger, "after 30 s too few subscribers on {}: starting anyway", lacking.join(", "));
             return Ok(false);
@@ -321,7 +327,8 @@ impl SimHandle {
             let state = r.state.take().context("lockstep: no controller state for the period")?;
             let round_trip_us = self.sent_at.map_or(0.0, |s| s.elapsed().as_secs_f64() * 1e6);
             let fusion_weight = self.inbox.borrow().fusion_weight;
-            let d = decision(&state, &applied, r.safe_stops, fusion_weight, round_trip_us).map_err(anyhow::Error::msg)?;
+            let d =
+                decision(&state, &applied, r.safe_stops, fusion_weight, round_trip_us).map_err(anyhow::Error::msg)?;
             r.safe_stops = state.safe_stop_cycles;
             r.run.cycle(self.bridge.world(), self.last_force, d);
         }
@@ -426,7 +433,8 @@ impl SimHandle {
                 "realtime_factor": sim / wall.max(1e-9),
                 "commands": self.record,
             });
-            std::fs::write(path, serde_json::to_string(&json)?).with_context(|| format!("--record {}", path.display()))?;
+            std::fs::write(path, serde_json::to_string(&json)?)
+                .with_context(|| format!("--record {}", path.display()))?;
         }
         let world = self.bridge.world();
         self.recorder.map(|r| write_report(r, world)).transpose()
@@ -454,7 +462,7 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
         // Not yet a topic: the controller's base reference comes from skin_sim's schedule only.
         r2r::log_warn!(
             &logger,
-            "{}: its {} base motion(s) (`base_motions`, paper 003 Exp. 1) are not carried by the graph: the controller holds the base at q_post, and a recorded run's \"with\" RMS covers these windows without the motion (run them with `skin_sim run`)",
+            "{}: its {} base motion(s) (`base_motions`, interactive-force-control paper Exp. 1) are not carried by the graph: the controller holds the base at q_post, and a recorded run's \"with\" RMS covers these windows without the motion (run them with `skin_sim run`)",
             file.display(),
             scene.spec.base_motions.len()
         );
@@ -467,7 +475,8 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
     if !(options.realtime_factor.is_finite() && options.realtime_factor > 0.0) {
         anyhow::bail!("--realtime-factor {}: must be > 0", options.realtime_factor);
     }
-    let bridge = SimBridge::new(scene.clone(), &options.arm_namespaces, &options.arm_prefixes).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    let bridge = SimBridge::new(scene.clone(), &options.arm_namespaces, &options.arm_prefixes)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
     let recorder = options.out.as_ref().map(|dir| start_recorder(&options, scene, &bridge, dir)).transpose()?;
     let end_s = options.duration.unwrap_or(bridge.duration_s());
     let pubs = Pubs {
@@ -482,7 +491,11 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
     let tf = match TfPublisher::new(node)? {
         Ok(tf) => {
             // The controller's world is the odometry frame (its base joints are the odometry).
-            let fixed = FrameTransform { parent: WORLD_FRAME.into(), child: ODOM_FRAME.into(), pose: nalgebra::Isometry3::identity() };
+            let fixed = FrameTransform {
+                parent: WORLD_FRAME.into(),
+                child: ODOM_FRAME.into(),
+                pose: nalgebra::Isometry3::identity(),
+            };
             tf.send_static(&[fixed], &time_msg(0.0)).context(TF_STATIC)?;
             Some(tf)
         }
@@ -491,7 +504,13 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
             None
         }
     };
-    let inbox = Rc::new(RefCell::new(Inbox { arms: vec![None; bridge.arms().len()], twist: None, state: None, fusion_weight: f64::NAN, errors: 0 }));
+    let inbox = Rc::new(RefCell::new(Inbox {
+        arms: vec![None; bridge.arms().len()],
+        twist: None,
+        state: None,
+        fusion_weight: f64::NAN,
+        errors: 0,
+    }));
     for (k, arm) in bridge.arms().iter().enumerate() {
         let mut sub = node.subscribe::<Float64MultiArray>(local(&arm.topic), qos::stream())?;
         let inbox = inbox.clone();
@@ -547,9 +566,16 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
 }
 
 /// `--out`: the run's record, judged with the scenario's (or `--controller`) setup.
-fn start_recorder(options: &Options, scene: skin_sim::scene::Scene, bridge: &SimBridge, dir: &std::path::Path) -> Result<Recorder> {
-    let target = RunTarget::resolve(&options.scene, options.controller.clone()).map_err(|e| anyhow::anyhow!("--scene: {e}"))?;
-    let run = ExternalRun::new(&target, scene, bridge.world()).with_context(|| format!("--out: {}", target.controller.display()))?;
+fn start_recorder(
+    options: &Options,
+    scene: skin_sim::scene::Scene,
+    bridge: &SimBridge,
+    dir: &std::path::Path,
+) -> Result<Recorder> {
+    let target =
+        RunTarget::resolve(&options.scene, options.controller.clone()).map_err(|e| anyhow::anyhow!("--scene: {e}"))?;
+    let run = ExternalRun::new(&target, scene, bridge.world())
+        .with_context(|| format!("--out: {}", target.controller.display()))?;
     Ok(Recorder { run, dir: dir.to_path_buf(), state: None, safe_stops: 0 })
 }
 

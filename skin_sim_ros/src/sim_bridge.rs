@@ -26,7 +26,6 @@ use skin_control::convert::robot::{base_joints, time_msg, write_goal, write_join
 use skin_control::convert::write_cell_array;
 use skin_control::tf::{BASE_FRAME, ODOM_FRAME, WORLD_FRAME};
 
-
 /// The messages of one control period, stamped with the simulation time.
 #[derive(Debug, Clone, Default)]
 pub struct SimMessages {
@@ -69,7 +68,8 @@ pub fn decision(
     fusion_weight: f64,
     round_trip_us: f64,
 ) -> Result<Decision, String> {
-    let mode = Mode::from_u8(state.mode).ok_or_else(|| format!("/controller/state: mode = {}: not an Arrangement.MODE_* constant", state.mode))?;
+    let mode = Mode::from_u8(state.mode)
+        .ok_or_else(|| format!("/controller/state: mode = {}: not an Arrangement.MODE_* constant", state.mode))?;
     Ok(Decision {
         joint_velocities: applied.joints.clone(),
         base_twist: applied.base,
@@ -115,7 +115,13 @@ impl SimBridge {
         let arms = split_arms(model.joint_names(), world.arm_joints(), namespaces, prefixes)?;
         let scan_geometry = spec.lidar.as_ref().map(|l| {
             let fov = l.fov_deg.to_radians();
-            let step = if l.rays == 1 { 0.0 } else if l.fov_deg >= 360.0 { fov / l.rays as f64 } else { fov / (l.rays - 1) as f64 };
+            let step = if l.rays == 1 {
+                0.0
+            } else if l.fov_deg >= 360.0 {
+                fov / l.rays as f64
+            } else {
+                fov / (l.rays - 1) as f64
+            };
             let first = if l.rays == 1 { 0.0 } else { -fov / 2.0 };
             (l.frame.clone(), first as f32, step as f32, l.range_m as f32)
         });
@@ -123,7 +129,8 @@ impl SimBridge {
             .goals
             .iter()
             .map(|g| {
-                let r = g.rpy.map_or(UnitQuaternion::identity(), |[r, p, y]| UnitQuaternion::from_euler_angles(r, p, y));
+                let r =
+                    g.rpy.map_or(UnitQuaternion::identity(), |[r, p, y]| UnitQuaternion::from_euler_angles(r, p, y));
                 (g.start_s, Isometry3::from_parts(Translation3::from(Vector3::from(g.position_m)), r))
             })
             .collect();
@@ -177,7 +184,10 @@ impl SimBridge {
     pub fn base_pose(&self) -> Option<Isometry3<f64>> {
         let q = self.world.q();
         self.base.map(|[x, y, yaw]| {
-            Isometry3::from_parts(Translation3::new(q[x], q[y], 0.0), UnitQuaternion::from_euler_angles(0.0, 0.0, q[yaw]))
+            Isometry3::from_parts(
+                Translation3::new(q[x], q[y], 0.0),
+                UnitQuaternion::from_euler_angles(0.0, 0.0, q[yaw]),
+            )
         })
     }
 
@@ -238,7 +248,8 @@ impl SimBridge {
             self.next_goal += 1;
         }
         let forces = &w.scene().spec.force_references;
-        m.force_n = forces.iter().filter(|f| f.start_s <= t).max_by(|a, b| a.start_s.total_cmp(&b.start_s)).map(|f| f.value(t));
+        m.force_n =
+            forces.iter().filter(|f| f.start_s <= t).max_by(|a, b| a.start_s.total_cmp(&b.start_s)).map(|f| f.value(t));
         &self.msgs
     }
 
@@ -273,7 +284,13 @@ impl SimBridge {
 /// last reading and reads zero before the first (`convert::CellBuffer`) sees every cell as if all
 /// were sent, also when it joins late; the message shrinks from every cell to the few near
 /// something, which is most of the graph's serialization cost.
-fn write_events(layout: &ResolvedLayout, readings: &[CellReading], stamp: &Time, sent: &mut Vec<CellReading>, msg: &mut SkinCellArray) {
+fn write_events(
+    layout: &ResolvedLayout,
+    readings: &[CellReading],
+    stamp: &Time,
+    sent: &mut Vec<CellReading>,
+    msg: &mut SkinCellArray,
+) {
     let zero = CellReading::default();
     write_cell_array(layout, readings, stamp, |k| readings[k] != zero || sent.get(k) != Some(&readings[k]), msg);
     sent.clear();
@@ -340,10 +357,13 @@ mod tests {
     /// changed (a cell back to zero once), never an unchanged zero one.
     #[test]
     fn cell_messages_carry_the_active_and_changed_cells() {
-        let layout = skin_core::skin::layout::SkinLayout::from_yaml_str(include_str!("../../skin_core/src/skin/testdata/two_patches.yaml"), "two_patches.yaml")
-            .unwrap()
-            .resolve_with(|l| Some(if l == "a" { 1 } else { 2 }))
-            .unwrap();
+        let layout = skin_core::skin::layout::SkinLayout::from_yaml_str(
+            include_str!("../../skin_core/src/skin/testdata/two_patches.yaml"),
+            "two_patches.yaml",
+        )
+        .unwrap()
+        .resolve_with(|l| Some(if l == "a" { 1 } else { 2 }))
+        .unwrap();
         let mut sent = Vec::new();
         let mut m = SkinCellArray::default();
         let mut ids = |readings: &[CellReading]| {

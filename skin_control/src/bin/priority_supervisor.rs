@@ -1,4 +1,4 @@
-//! `priority_supervisor`: paper 000 Table I / paper 003 Table 1 on the ROS graph. Wiring in
+//! `priority_supervisor`: intentional-contact paper Table I / interactive-force-control paper Table 1 on the ROS graph. Wiring in
 //! `skin_control::nodes::priority_supervisor`, work in `skin_control::supervisor_node`.
 use std::time::Duration;
 

@@ -1,4 +1,4 @@
-//! `skin_aggregator`: skin cells in, patch wrenches and RViz markers out (paper 003 eq. 6-8).
+//! `skin_aggregator`: skin cells in, patch wrenches and RViz markers out (interactive-force-control paper eq. 6-8).
 //! The node's wiring only; the work is in `skin_control::aggregator`. See docs/ros.md.
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -11,9 +11,9 @@ use r2r::visualization_msgs::msg::MarkerArray;
 use r2r::{ParameterValue, RosParams};
 use skin_control::aggregator::{Aggregator, SKIN_PARAM_DESCRIPTIONS};
 use skin_control::convert::{patch_frame_id, IssueKind};
-use skin_control::ros_params::StructParams;
 use skin_control::nodes::topics::{CELLS as CELLS_TOPIC, MARKERS as MARKERS_TOPIC, PATCHES as PATCHES_TOPIC};
 use skin_control::nodes::{self, file_setting, resolve};
+use skin_control::ros_params::StructParams;
 use skin_control::tf::{FrameTransform, TfPublisher};
 use skin_control::{markers, qos, shutdown};
 use skin_core::model::RobotModel;
@@ -58,35 +58,18 @@ struct Setup {
 fn setup(node: &r2r::Node, args: Args) -> Result<Setup> {
     let urdf = file_setting(node, args.urdf, "urdf_file", "urdf/tomm.urdf")?;
     let layout_file = file_setting(node, args.layout, "layout_file", "config/skin/tomm.yaml")?;
-    let skin_model = file_setting(
-        node,
-        args.skin_model,
-        "skin_model_file",
-        "config/skin_model.yaml",
-    )?;
+    let skin_model = file_setting(node, args.skin_model, "skin_model_file", "config/skin_model.yaml")?;
     let model = RobotModel::from_urdf_file(&resolve(&urdf, "urdf_file")?)?;
     let layout = SkinLayout::load(&resolve(&layout_file, "layout_file")?)?.resolve(&model)?;
     let defaults = SkinParams::load(&resolve(&skin_model, "skin_model_file")?)?;
-    let mut params = StructParams::new(
-        defaults,
-        |p| p.validate().map_err(|e| e.to_string()),
-        SKIN_PARAM_DESCRIPTIONS,
-    )?
-    .with_read_only(
-        "urdf_file",
-        ParameterValue::String(urdf),
-        "Robot URDF (read at start)",
-    )
-    .with_read_only(
-        "layout_file",
-        ParameterValue::String(layout_file),
-        "Skin layout (read at start)",
-    )
-    .with_read_only(
-        "skin_model_file",
-        ParameterValue::String(skin_model),
-        "Skin model file: initial values of the other parameters (read at start)",
-    );
+    let mut params = StructParams::new(defaults, |p| p.validate().map_err(|e| e.to_string()), SKIN_PARAM_DESCRIPTIONS)?
+        .with_read_only("urdf_file", ParameterValue::String(urdf), "Robot URDF (read at start)")
+        .with_read_only("layout_file", ParameterValue::String(layout_file), "Skin layout (read at start)")
+        .with_read_only(
+            "skin_model_file",
+            ParameterValue::String(skin_model),
+            "Skin model file: initial values of the other parameters (read at start)",
+        );
     // Here rather than inside r2r's registration: this error says where the value came from.
     params
         .apply_overrides(&node.params.lock().unwrap())
@@ -112,10 +95,7 @@ impl Timing {
 
 impl std::fmt::Display for Timing {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let mean = self
-            .total
-            .checked_div(self.count.max(1) as u32)
-            .unwrap_or_default();
+        let mean = self.total.checked_div(self.count.max(1) as u32).unwrap_or_default();
         write!(f, "mean {mean:?}, max {:?}", self.max)
     }
 }
@@ -131,11 +111,11 @@ fn main() -> Result<()> {
     let Setup { layout, params } = setup(&node, args)?;
     let params = Arc::new(Mutex::new(params));
     let served: Arc<Mutex<dyn RosParams + Send>> = params.clone();
-    let (param_services, mut param_changes) = node
-        .make_derived_parameter_handler(served)
-        .context("declaring the parameters")?;
+    let (param_services, mut param_changes) =
+        node.make_derived_parameter_handler(served).context("declaring the parameters")?;
     // Read from the serialized bytes (convert::cdr_cells: no C message per message).
-    let mut cells = node.subscribe_raw(nodes::local(CELLS_TOPIC), nodes::topics::CELLS_TYPE, qos::sensor_input(1000))?;
+    let mut cells =
+        node.subscribe_raw(nodes::local(CELLS_TOPIC), nodes::topics::CELLS_TYPE, qos::sensor_input(1000))?;
     let patches_pub = node.create_publisher::<PatchWrenchArray>(nodes::local(PATCHES_TOPIC), qos::stream())?;
     let markers_pub = node.create_publisher::<MarkerArray>(nodes::local(MARKERS_TOPIC), qos::stream())?;
     // The patch frames {p_j} that /skin/patches is expressed in, fixed in their links.
@@ -144,9 +124,14 @@ fn main() -> Result<()> {
             let frames: Vec<FrameTransform> = layout
                 .patches()
                 .iter()
-                .map(|p| FrameTransform { parent: p.link.clone(), child: patch_frame_id(p.id), pose: p.link_from_patch })
+                .map(|p| FrameTransform {
+                    parent: p.link.clone(),
+                    child: patch_frame_id(p.id),
+                    pose: p.link_from_patch,
+                })
                 .collect();
-            tf.send_static(&frames, &r2r::builtin_interfaces::msg::Time::default()).context(nodes::topics::TF_STATIC)?;
+            tf.send_static(&frames, &r2r::builtin_interfaces::msg::Time::default())
+                .context(nodes::topics::TF_STATIC)?;
             Some(tf)
         }
         Err(why) => {
@@ -197,10 +182,7 @@ fn main() -> Result<()> {
             let read = agg.process(&msg, &fusion, |issue| {
                 // Each kind once, with an example; the counts go into the shutdown summary.
                 if !std::mem::replace(&mut logged[issue.kind as usize], true) {
-                    r2r::log_warn!(
-                        &log,
-                        "{CELLS_TOPIC}: {issue} (further ones are counted, totals at shutdown)"
-                    );
+                    r2r::log_warn!(&log, "{CELLS_TOPIC}: {issue} (further ones are counted, totals at shutdown)");
                 }
             });
             let (patches, markers) = match read {
@@ -213,18 +195,13 @@ fn main() -> Result<()> {
                 }
             };
             let built = start.elapsed();
-            let sent = patches_pub
-                .publish(patches)
-                .map_err(|e| format!("{PATCHES_TOPIC}: {e}"))
-                .and_then(|_| {
-                    if markers.markers.is_empty() {
-                        Ok(())
-                    } else {
-                        markers_out
-                            .publish(markers)
-                            .map_err(|e| format!("{MARKERS_TOPIC}: {e}"))
-                    }
-                });
+            let sent = patches_pub.publish(patches).map_err(|e| format!("{PATCHES_TOPIC}: {e}")).and_then(|_| {
+                if markers.markers.is_empty() {
+                    Ok(())
+                } else {
+                    markers_out.publish(markers).map_err(|e| format!("{MARKERS_TOPIC}: {e}"))
+                }
+            });
             if let Err(e) = sent {
                 if !std::mem::replace(&mut publish_failed, true) {
                     r2r::log_error!(&log, "publishing failed: {e}");
@@ -241,9 +218,7 @@ fn main() -> Result<()> {
         pool.run_until_stalled();
     }
     // Leave RViz clean: the markers would otherwise stay on screen.
-    let clear = MarkerArray {
-        markers: vec![markers::delete_all()],
-    };
+    let clear = MarkerArray { markers: vec![markers::delete_all()] };
     if let Err(e) = markers_pub.publish(&clear) {
         r2r::log_warn!(&logger, "{MARKERS_TOPIC}: clearing the markers failed: {e}");
     }

@@ -123,8 +123,18 @@ fn main() -> Result<()> {
     let trips = node.create_publisher::<Header>(local(WATCHDOG), qos::stream())?;
     let mut beats = node.subscribe::<Header>(local(heartbeat::TOPIC), qos::stream())?;
     let learn = if args.learn_topics { " and the topics the heartbeats name" } else { "" };
-    r2r::log_info!(&logger, "watching {} (timeout {} s); zeros on {}{learn}", heartbeat::TOPIC, args.timeout_s, out.topics().join(", "));
-    let mut dog = Watchdog::new(Duration::from_secs_f64(args.timeout_s), Duration::from_secs_f64(args.hold_period_s), Instant::now());
+    r2r::log_info!(
+        &logger,
+        "watching {} (timeout {} s); zeros on {}{learn}",
+        heartbeat::TOPIC,
+        args.timeout_s,
+        out.topics().join(", ")
+    );
+    let mut dog = Watchdog::new(
+        Duration::from_secs_f64(args.timeout_s),
+        Duration::from_secs_f64(args.hold_period_s),
+        Instant::now(),
+    );
     let mut last_sender = String::from("none yet");
     let mut failed = false;
     while !shutdown::requested() {
@@ -150,9 +160,15 @@ fn main() -> Result<()> {
         }
         let mut sent = out.zeros();
         if verdict == Verdict::Trip {
-            let why = format!("no heartbeat for {} s from {last_sender}: zero commands on {}", args.timeout_s, out.topics().join(", "));
+            let why = format!(
+                "no heartbeat for {} s from {last_sender}: zero commands on {}",
+                args.timeout_s,
+                out.topics().join(", ")
+            );
             r2r::log_error!(&logger, "{why}");
-            let stamp = skin_control::convert::robot::time_msg(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH)?.as_secs_f64());
+            let stamp = skin_control::convert::robot::time_msg(
+                std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH)?.as_secs_f64(),
+            );
             sent = sent.and(trips.publish(&Header { stamp, frame_id: why }));
         }
         if let Err(e) = sent {

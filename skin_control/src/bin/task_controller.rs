@@ -37,7 +37,11 @@ fn main() -> Result<()> {
     args.wait.wait(task_controller::NODE, &handle.output_topics(), |t| handle.subscription_count(t))?;
     nodes::spin(&mut node, &mut pool, || {
         handle.poll();
-        if handle.yielded().is_some() { Pass::Done } else { Pass::Idle }
+        if handle.yielded().is_some() {
+            Pass::Done
+        } else {
+            Pass::Idle
+        }
     });
     if let Some(why) = handle.yielded() {
         anyhow::bail!("{why}");

@@ -34,7 +34,10 @@ impl<'a> Cursor<'a> {
     /// The next `n` bytes after aligning to `align`.
     fn bytes(&mut self, n: usize, align: usize, field: &str) -> Result<&'a [u8], String> {
         let start = self.pos.next_multiple_of(align);
-        let bytes = self.payload.get(start..start.saturating_add(n)).ok_or_else(|| format!("ends inside {field} (offset {start})"))?;
+        let bytes = self
+            .payload
+            .get(start..start.saturating_add(n))
+            .ok_or_else(|| format!("ends inside {field} (offset {start})"))?;
         self.pos = start + n;
         Ok(bytes)
     }
@@ -67,7 +70,9 @@ impl CdrCells {
         (self.acceleration_len, self.temperature_len) = (0, 0);
         let payload = match data.split_first_chunk::<4>() {
             Some(([0, 1, _, _], payload)) => payload,
-            Some((header, _)) => return Err(format!("CDR encapsulation {header:02x?}: only little-endian CDR (00 01) is read")),
+            Some((header, _)) => {
+                return Err(format!("CDR encapsulation {header:02x?}: only little-endian CDR (00 01) is read"))
+            }
             None => return Err(format!("{} bytes: shorter than the CDR header", data.len())),
         };
         let mut c = Cursor { payload, pos: 0 };
@@ -82,7 +87,10 @@ impl CdrCells {
         let (_, temperature_len) = c.words("temperature")?;
         // the type support pads a message to a multiple of 4 bytes at most: more is another type
         if payload.len() - c.pos >= 4 {
-            return Err(format!("{} bytes after temperature: not a skin_msgs/SkinCellArray of this definition", payload.len() - c.pos));
+            return Err(format!(
+                "{} bytes after temperature: not a skin_msgs/SkinCellArray of this definition",
+                payload.len() - c.pos
+            ));
         }
         read_words(ids, &mut self.cell_id, u32::from_le_bytes);
         read_words(force, &mut self.force, f32::from_le_bytes);

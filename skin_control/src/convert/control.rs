@@ -92,7 +92,13 @@ pub fn write_arm_command(arm: &ArmCommand, joint_velocities: &[f64], msg: &mut F
 /// topic and the field.
 pub fn read_arm_command(arm: &ArmCommand, msg: &Float64MultiArray, joint_velocities: &mut [f64]) -> Result<(), String> {
     if msg.data.len() != arm.slots.len() {
-        return Err(format!("{}: data has {} values, expected {} ({})", arm.topic, msg.data.len(), arm.slots.len(), arm.joints.join(", ")));
+        return Err(format!(
+            "{}: data has {} values, expected {} ({})",
+            arm.topic,
+            msg.data.len(),
+            arm.slots.len(),
+            arm.joints.join(", ")
+        ));
     }
     if let Some(i) = msg.data.iter().position(|v| !v.is_finite()) {
         return Err(format!("{}: data[{i}] is not finite", arm.topic));
@@ -193,7 +199,8 @@ pub fn arrangement_msg(a: &Arrangement, tasks: &[String]) -> ArrangementMsg {
 /// message's task order is the one this configuration gives its mode (the nodes must share the
 /// supervisor configuration). Errors name the field.
 pub fn imposed_of(msg: &ArrangementMsg, configured: impl Fn(Mode) -> Vec<String>) -> Result<Imposed, String> {
-    let mode = Mode::from_u8(msg.mode).ok_or_else(|| format!("mode = {}: not an Arrangement.MODE_* constant", msg.mode))?;
+    let mode =
+        Mode::from_u8(msg.mode).ok_or_else(|| format!("mode = {}: not an Arrangement.MODE_* constant", msg.mode))?;
     let expected = configured(mode);
     if msg.task_order != expected {
         return Err(format!(
@@ -201,7 +208,11 @@ pub fn imposed_of(msg: &ArrangementMsg, configured: impl Fn(Mode) -> Vec<String>
             msg.task_order, msg.mode, expected
         ));
     }
-    for (field, v) in [("smoothing_gain", msg.smoothing_gain), ("sensing_range", msg.sensing_range), ("fusion_weight", msg.fusion_weight)] {
+    for (field, v) in [
+        ("smoothing_gain", msg.smoothing_gain),
+        ("sensing_range", msg.sensing_range),
+        ("fusion_weight", msg.fusion_weight),
+    ] {
         if !v.is_finite() {
             return Err(format!("{field} = {v}: not finite"));
         }
@@ -225,7 +236,9 @@ mod tests {
     #[test]
     fn arms_split_by_prefix_and_round_trip() {
         let joints = names(&["base_x_joint", "left_a", "left_b", "right_a", "right_b"]);
-        let arms = split_arms(&joints, &[1, 2, 3, 4], &names(&["/left_arm", "/right_arm/"]), &names(&["left_", "right_"])).unwrap();
+        let arms =
+            split_arms(&joints, &[1, 2, 3, 4], &names(&["/left_arm", "/right_arm/"]), &names(&["left_", "right_"]))
+                .unwrap();
         assert_eq!(arms[1].topic, "/right_arm/forward_velocity_controller/commands");
         assert_eq!(arms[1].joints, names(&["right_a", "right_b"]));
         assert_eq!(arms[1].slots, vec![2, 3]);
@@ -259,7 +272,13 @@ mod tests {
             sensing_range: 0.05,
             fusion_weight: 0.5,
         };
-        let cfg = |m: Mode| if m == Mode::IntentionalContact { names(&["goal", "contact_reaction", "avoidance"]) } else { vec![] };
+        let cfg = |m: Mode| {
+            if m == Mode::IntentionalContact {
+                names(&["goal", "contact_reaction", "avoidance"])
+            } else {
+                vec![]
+            }
+        };
         let a = imposed_of(&msg, cfg).unwrap();
         assert_eq!((a.mode, a.switch_time_s, a.sensing_range_m), (Mode::IntentionalContact, 2.5, 0.05));
         let bad = ArrangementMsg { mode: 9, ..msg.clone() };

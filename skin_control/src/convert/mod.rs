@@ -92,7 +92,12 @@ impl CellMessage for SkinCellArray {
 /// Writes the cells of `msg` into `buf` (the rules of `skin_core::skin::cell_input`); `report`
 /// is called for every issue. A message whose arrays disagree is refused whole: the reason names
 /// the array, `buf` is unchanged. No allocation.
-pub fn update_cells(buf: &mut CellBuffer, layout: &ResolvedLayout, msg: &impl CellMessage, report: impl FnMut(&Issue)) -> Result<(), String> {
+pub fn update_cells(
+    buf: &mut CellBuffer,
+    layout: &ResolvedLayout,
+    msg: &impl CellMessage,
+    report: impl FnMut(&Issue),
+) -> Result<(), String> {
     buf.update(layout, msg.arrays().samples()?, report);
     Ok(())
 }
@@ -136,26 +141,16 @@ fn write_patch_frame_id(out: &mut String, patch_id: u32) {
 }
 
 fn vector_msg(v: &Vector3<f64>) -> Vector3Msg {
-    Vector3Msg {
-        x: v.x,
-        y: v.y,
-        z: v.z,
-    }
+    Vector3Msg { x: v.x, y: v.y, z: v.z }
 }
 
 /// Writes `wrenches` (indexed like `layout.patches()`) into `msg`, one entry per patch in layout
 /// order, every entry stamped `stamp`. Reuses `msg`'s storage: after the first call it allocates
 /// nothing.
-pub fn write_patch_array(
-    layout: &ResolvedLayout,
-    wrenches: &[PatchWrench],
-    stamp: &Time,
-    msg: &mut PatchWrenchArray,
-) {
+pub fn write_patch_array(layout: &ResolvedLayout, wrenches: &[PatchWrench], stamp: &Time, msg: &mut PatchWrenchArray) {
     msg.header.stamp = stamp.clone();
     msg.header.frame_id.clear();
-    msg.patches
-        .resize_with(layout.patches().len(), PatchWrenchMsg::default);
+    msg.patches.resize_with(layout.patches().len(), PatchWrenchMsg::default);
     for ((out, patch), w) in msg.patches.iter_mut().zip(layout.patches()).zip(wrenches) {
         out.header.stamp = stamp.clone();
         write_patch_frame_id(&mut out.header.frame_id, patch.id);
@@ -164,11 +159,7 @@ pub fn write_patch_array(
         out.link.push_str(&patch.link);
         out.wrench.force = vector_msg(&w.force);
         out.wrench.torque = vector_msg(&w.moment);
-        out.centroid = Point {
-            x: w.centroid.x,
-            y: w.centroid.y,
-            z: w.centroid.z,
-        };
+        out.centroid = Point { x: w.centroid.x, y: w.centroid.y, z: w.centroid.z };
         out.active_cells = u32::try_from(w.active_cells).unwrap_or(u32::MAX);
         out.max_force = w.max_force_signal as f32;
         out.max_proximity = w.max_proximity_signal as f32;
@@ -226,10 +217,9 @@ impl fmt::Display for PatchArrayError {
             PatchArrayError::DuplicatePatch { index, patch_id } => {
                 write!(f, "patches[{index}].patch_id: patch {patch_id} appears twice")
             }
-            PatchArrayError::LinkMismatch { index, patch_id, got, expected } => write!(
-                f,
-                "patches[{index}].link: `{got}`, but patch {patch_id} is on `{expected}` in the layout"
-            ),
+            PatchArrayError::LinkMismatch { index, patch_id, got, expected } => {
+                write!(f, "patches[{index}].link: `{got}`, but patch {patch_id} is on `{expected}` in the layout")
+            }
             PatchArrayError::NonFinite { index, field } => {
                 write!(f, "patches[{index}].{field}: not finite")
             }
@@ -257,9 +247,7 @@ pub fn read_patch_array(
     out.resize(layout.patches().len(), PatchWrench::default());
     for (index, p) in msg.patches.iter().enumerate() {
         let patch_id = p.patch_id;
-        let k = layout
-            .patch_index(patch_id)
-            .ok_or(PatchArrayError::UnknownPatch { index, patch_id })?;
+        let k = layout.patch_index(patch_id).ok_or(PatchArrayError::UnknownPatch { index, patch_id })?;
         // A handful of patches per robot: a scan is cheaper than a set.
         if msg.patches[..index].iter().any(|q| q.patch_id == patch_id) {
             return Err(PatchArrayError::DuplicatePatch { index, patch_id });
@@ -294,11 +282,7 @@ pub fn read_patch_array(
         }
         out[k] = w;
     }
-    match layout
-        .patches()
-        .iter()
-        .find(|lp| !msg.patches.iter().any(|p| p.patch_id == lp.id))
-    {
+    match layout.patches().iter().find(|lp| !msg.patches.iter().any(|p| p.patch_id == lp.id)) {
         Some(lp) => Err(PatchArrayError::MissingPatch { patch_id: lp.id }),
         None => Ok(()),
     }
@@ -313,10 +297,13 @@ mod tests {
 
     /// Two patches on links `a` and `b`, cells 10, 11 (patch 7) and 20 (patch 3).
     fn layout() -> ResolvedLayout {
-        SkinLayout::from_yaml_str(include_str!("../../../skin_core/src/skin/testdata/two_patches.yaml"), "two_patches.yaml")
-            .unwrap()
-            .resolve_with(|l| Some(if l == "a" { 1 } else { 2 }))
-            .unwrap()
+        SkinLayout::from_yaml_str(
+            include_str!("../../../skin_core/src/skin/testdata/two_patches.yaml"),
+            "two_patches.yaml",
+        )
+        .unwrap()
+        .resolve_with(|l| Some(if l == "a" { 1 } else { 2 }))
+        .unwrap()
     }
 
     /// A message of `(id, force, proximity)` cells.
@@ -340,7 +327,12 @@ mod tests {
     fn cells_read_from_the_arrays_by_index() {
         let l = layout();
         let mut buf = CellBuffer::new(&l);
-        let msg = cells(&[(11, [0.5, f32::NAN, 2.0], -0.5), (99, [0.1; 3], 0.1), (10, [0.25, 0.5, 0.75], 0.125), (11, [0.9; 3], 0.9)]);
+        let msg = cells(&[
+            (11, [0.5, f32::NAN, 2.0], -0.5),
+            (99, [0.1; 3], 0.1),
+            (10, [0.25, 0.5, 0.75], 0.125),
+            (11, [0.9; 3], 0.9),
+        ]);
         let issues = update(&mut buf, &l, &msg);
         let kinds: Vec<_> = issues.iter().map(|i| (i.cell_id, i.kind)).collect();
         use IssueKind::*;
@@ -388,37 +380,21 @@ mod tests {
     fn patch_array_round_trip() {
         let l = layout();
         let mut buf = CellBuffer::new(&l);
-        update(
-            &mut buf,
-            &l,
-            &cells(&[(10, [0.5; 3], 0.2), (20, [0.0; 3], 0.8)]),
-        );
-        let fusion = FusionParams {
-            weight_force: 0.5,
-            activity_threshold: 0.02,
-            force_reduction: ForceReduction::Mean,
-        };
+        update(&mut buf, &l, &cells(&[(10, [0.5; 3], 0.2), (20, [0.0; 3], 0.8)]));
+        let fusion =
+            FusionParams { weight_force: 0.5, activity_threshold: 0.02, force_reduction: ForceReduction::Mean };
         let mut wrenches = Vec::new();
         aggregate_patches(&l, buf.readings(), &fusion, &mut wrenches).unwrap();
-        let stamp = Time {
-            sec: 12,
-            nanosec: 34,
-        };
+        let stamp = Time { sec: 12, nanosec: 34 };
         let mut msg = PatchWrenchArray::default();
         write_patch_array(&l, &wrenches, &stamp, &mut msg);
         assert_eq!(msg.patches.len(), 2);
         let p = &msg.patches[1];
-        assert_eq!(
-            (p.patch_id, p.link.as_str(), p.header.frame_id.as_str()),
-            (3, "b", "skin_patch_3")
-        );
+        assert_eq!((p.patch_id, p.link.as_str(), p.header.frame_id.as_str()), (3, "b", "skin_patch_3"));
         assert_eq!(p.header.frame_id, patch_frame_id(3));
         assert_eq!(p.header.stamp, stamp);
         assert_eq!(p.active_cells, 1);
-        assert!(
-            (p.wrench.force.z - 0.4).abs() < 1e-7,
-            "0.8 travels as float32"
-        );
+        assert!((p.wrench.force.z - 0.4).abs() < 1e-7, "0.8 travels as float32");
         let mut back = Vec::new();
         read_patch_array(&l, &msg, &mut back).unwrap();
         for (a, b) in back.iter().zip(&wrenches) {
@@ -439,13 +415,8 @@ mod tests {
         let mut out = Vec::new();
         let mut bad = msg.clone();
         bad.patches[1].link = "c".into();
-        let e = read_patch_array(&l, &bad, &mut out)
-            .unwrap_err()
-            .to_string();
-        assert_eq!(
-            e,
-            "patches[1].link: `c`, but patch 3 is on `b` in the layout"
-        );
+        let e = read_patch_array(&l, &bad, &mut out).unwrap_err().to_string();
+        assert_eq!(e, "patches[1].link: `c`, but patch 3 is on `b` in the layout");
         let mut bad = msg.clone();
         bad.patches.pop();
         let e = read_patch_array(&l, &bad, &mut out).unwrap_err();
@@ -453,28 +424,14 @@ mod tests {
         let mut bad = msg.clone();
         bad.patches[1] = bad.patches[0].clone();
         let e = read_patch_array(&l, &bad, &mut out).unwrap_err();
-        assert_eq!(
-            e,
-            PatchArrayError::DuplicatePatch {
-                index: 1,
-                patch_id: 7
-            }
-        );
+        assert_eq!(e, PatchArrayError::DuplicatePatch { index: 1, patch_id: 7 });
         let mut bad = msg.clone();
         bad.patches[0].wrench.torque.y = f64::NAN;
-        let e = read_patch_array(&l, &bad, &mut out)
-            .unwrap_err()
-            .to_string();
+        let e = read_patch_array(&l, &bad, &mut out).unwrap_err().to_string();
         assert_eq!(e, "patches[0].wrench.torque: not finite");
         let mut bad = msg;
         bad.patches[0].patch_id = 8;
         let e = read_patch_array(&l, &bad, &mut out).unwrap_err();
-        assert_eq!(
-            e,
-            PatchArrayError::UnknownPatch {
-                index: 0,
-                patch_id: 8
-            }
-        );
+        assert_eq!(e, PatchArrayError::UnknownPatch { index: 0, patch_id: 8 });
     }
 }

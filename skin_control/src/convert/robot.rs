@@ -33,10 +33,7 @@ use skin_core::resolver::BASE_JOINTS;
 /// Seconds as a `builtin_interfaces/Time` (rounded to the nanosecond; negative times clamp to 0).
 pub fn time_msg(t_s: f64) -> Time {
     let ns = (t_s.max(0.0) * 1e9).round() as u64;
-    Time {
-        sec: (ns / 1_000_000_000) as i32,
-        nanosec: (ns % 1_000_000_000) as u32,
-    }
+    Time { sec: (ns / 1_000_000_000) as i32, nanosec: (ns % 1_000_000_000) as u32 }
 }
 
 /// A `builtin_interfaces/Time` in seconds.
@@ -210,7 +207,8 @@ impl StateBuffer {
     /// Oldest and newest time \[s\] of the joints that are not base joints (None: one has none).
     pub fn joint_times(&self) -> Option<(f64, f64)> {
         let arm = self.time.iter().enumerate().filter(|(j, _)| !self.base.is_some_and(|b| b.contains(j)));
-        arm.map(|(_, t)| *t).try_fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| t.map(|t| (lo.min(t), hi.max(t))))
+        arm.map(|(_, t)| *t)
+            .try_fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| t.map(|t| (lo.min(t), hi.max(t))))
     }
 
     /// Stamp \[s\] of the last odometry message that was used.
@@ -220,11 +218,7 @@ impl StateBuffer {
 
     /// Names of the joints that have not had a value yet (empty: the state is complete).
     pub fn missing(&self) -> impl Iterator<Item = &str> + '_ {
-        self.names
-            .iter()
-            .zip(&self.time)
-            .filter(|(_, t)| t.is_none())
-            .map(|(n, _)| n.as_str())
+        self.names.iter().zip(&self.time).filter(|(_, t)| t.is_none()).map(|(n, _)| n.as_str())
     }
 
     /// Whether every joint (base included) has a measured position.
@@ -235,17 +229,17 @@ impl StateBuffer {
     /// Writes the joints named in `msg` (rules in the module doc); `report` gets every issue. A
     /// joint time later than `void_after` \[s\] (the clock plus the allowed lead: the clock went
     /// back) does not hold back older stamps. Returns the number of joints written.
-    pub fn update_joints(&mut self, msg: &JointState, void_after: f64, mut report: impl FnMut(&JointStateIssue)) -> usize {
+    pub fn update_joints(
+        &mut self,
+        msg: &JointState,
+        void_after: f64,
+        mut report: impl FnMut(&JointStateIssue),
+    ) -> usize {
         self.messages += 1;
         let t = time_s(&msg.header.stamp);
         let mut note = |issues: &mut JointIssueCounts, kind, index, field, joint: &str| {
             issues.0[kind as usize] += 1;
-            report(&JointStateIssue {
-                kind,
-                index,
-                joint: joint.to_string(),
-                field,
-            });
+            report(&JointStateIssue { kind, index, joint: joint.to_string(), field });
         };
         let mut written = 0;
         for (i, name) in msg.name.iter().enumerate() {
@@ -356,10 +350,7 @@ pub fn odometry_base(msg: &Odometry) -> Result<BaseState, String> {
     let yaw = yaw_of(o);
     let (s, c) = yaw.sin_cos();
     let (vx, vy) = (t.linear.x, t.linear.y);
-    Ok(BaseState {
-        q: [p.position.x, p.position.y, yaw],
-        qd: [c * vx - s * vy, s * vx + c * vy, t.angular.z],
-    })
+    Ok(BaseState { q: [p.position.x, p.position.y, yaw], qd: [c * vx - s * vy, s * vx + c * vy, t.angular.z] })
 }
 
 /// Writes the base state into an odometry message (the inverse of [`odometry_base`]): pose in
@@ -370,10 +361,8 @@ pub fn write_odometry(base: &BaseState, stamp: &Time, odom_frame: &str, base_fra
     msg.child_frame_id = base_frame.to_string();
     let [x, y, yaw] = base.q;
     let (s2, c2) = (yaw / 2.0).sin_cos();
-    msg.pose.pose = Pose {
-        position: Point { x, y, z: 0.0 },
-        orientation: QuaternionMsg { x: 0.0, y: 0.0, z: s2, w: c2 },
-    };
+    msg.pose.pose =
+        Pose { position: Point { x, y, z: 0.0 }, orientation: QuaternionMsg { x: 0.0, y: 0.0, z: s2, w: c2 } };
     let (s, c) = yaw.sin_cos();
     let [vxw, vyw, wz] = base.qd;
     msg.twist.twist = Twist::default();
@@ -383,7 +372,14 @@ pub fn write_odometry(base: &BaseState, stamp: &Time, odom_frame: &str, base_fra
 }
 
 /// Writes the named joints' state (positions and velocities picked from model-order vectors).
-pub fn write_joint_state(names: &[String], indices: &[usize], q: &[f64], qd: &[f64], stamp: &Time, msg: &mut JointState) {
+pub fn write_joint_state(
+    names: &[String],
+    indices: &[usize],
+    q: &[f64],
+    qd: &[f64],
+    stamp: &Time,
+    msg: &mut JointState,
+) {
     msg.header.stamp = stamp.clone();
     if msg.name.len() != names.len() {
         msg.name = names.to_vec();
@@ -417,10 +413,7 @@ impl ScanConverter {
                 }
             }
         }
-        ScanConverter {
-            frames,
-            points: Vec::new(),
-        }
+        ScanConverter { frames, points: Vec::new() }
     }
 
     /// The points of the last converted scan \[m\], base frame.
@@ -433,9 +426,7 @@ impl ScanConverter {
         self.points.clear();
         let frame = &msg.header.frame_id;
         let Some((_, pose)) = self.frames.iter().find(|(n, _)| n == frame) else {
-            return Err(format!(
-                "header.frame_id `{frame}` is not a frame on the robot base of the model"
-            ));
+            return Err(format!("header.frame_id `{frame}` is not a frame on the robot base of the model"));
         };
         for (field, v) in [
             ("angle_min", msg.angle_min),
@@ -467,7 +458,15 @@ impl ScanConverter {
 pub fn goal_pose(msg: &PoseStamped) -> Result<Isometry3<f64>, String> {
     let p = &msg.pose.position;
     let o = &msg.pose.orientation;
-    let all = [("x", p.x), ("y", p.y), ("z", p.z), ("orientation.x", o.x), ("orientation.y", o.y), ("orientation.z", o.z), ("orientation.w", o.w)];
+    let all = [
+        ("x", p.x),
+        ("y", p.y),
+        ("z", p.z),
+        ("orientation.x", o.x),
+        ("orientation.y", o.y),
+        ("orientation.z", o.z),
+        ("orientation.w", o.w),
+    ];
     if let Some((field, v)) = all.iter().find(|(_, v)| !v.is_finite()) {
         let field = if field.starts_with('o') { format!("pose.{field}") } else { format!("pose.position.{field}") };
         return Err(format!("{field} = {v}: not finite"));
@@ -512,7 +511,14 @@ mod tests {
         let mut buf = StateBuffer::new(&model);
         let mut issues = Vec::new();
         let msg = JointState {
-            name: vec!["right_elbow_joint".into(), "bogus".into(), "base_x_joint".into(), "right_elbow_joint".into(), "left_elbow_joint".into(), "right_wrist_1_joint".into()],
+            name: vec![
+                "right_elbow_joint".into(),
+                "bogus".into(),
+                "base_x_joint".into(),
+                "right_elbow_joint".into(),
+                "left_elbow_joint".into(),
+                "right_wrist_1_joint".into(),
+            ],
             position: vec![1.0, 2.0, 3.0, 4.0, f64::NAN, 0.5],
             velocity: vec![0.1, 0.0, 0.0, 0.0, 0.2],
             ..Default::default()
@@ -525,7 +531,13 @@ mod tests {
         assert_eq!((buf.q()[le], buf.qd()[le]), (0.0, 0.0), "NaN position: the joint is not written at all");
         assert_eq!((buf.q()[rw], buf.qd()[rw]), (0.5, 0.0), "missing velocity keeps 0");
         let c = buf.issues();
-        for (kind, n) in [(JointIssue::UnknownJoint, 1), (JointIssue::BaseJoint, 1), (JointIssue::DuplicateJoint, 1), (JointIssue::NonFinite, 1), (JointIssue::MissingVelocity, 1)] {
+        for (kind, n) in [
+            (JointIssue::UnknownJoint, 1),
+            (JointIssue::BaseJoint, 1),
+            (JointIssue::DuplicateJoint, 1),
+            (JointIssue::NonFinite, 1),
+            (JointIssue::MissingVelocity, 1),
+        ] {
             assert_eq!(c.get(kind), n, "{kind:?}");
         }
         assert_eq!(issues[0].to_string(), "name[1] (joint `bogus`): unknown joint (ignored)");
@@ -553,13 +565,21 @@ mod tests {
         };
         let mut none = |_: &JointStateIssue| panic!("no issue");
         assert_eq!(buf.update_joints(&arm("left_", 10.0, 0.1), f64::INFINITY, &mut none), 6);
-        assert_eq!(buf.update_joints(&arm("right_", 9.98, 0.2), f64::INFINITY, &mut none), 6, "the lagging driver is accepted");
+        assert_eq!(
+            buf.update_joints(&arm("right_", 9.98, 0.2), f64::INFINITY, &mut none),
+            6,
+            "the lagging driver is accepted"
+        );
         assert_eq!(buf.joint_times().unwrap(), (9.98, 10.0));
         assert_eq!(buf.update_joints(&arm("right_", 9.99, 0.3), f64::INFINITY, &mut none), 6);
         assert_eq!(buf.update_joints(&arm("left_", 10.01, 0.4), f64::INFINITY, &mut none), 6);
         assert_eq!(buf.joint_times().unwrap(), (9.99, 10.01));
         let mut kinds = Vec::new();
-        assert_eq!(buf.update_joints(&arm("left_", 10.0, 9.0), f64::INFINITY, |i| kinds.push(i.kind)), 0, "older than the left joints");
+        assert_eq!(
+            buf.update_joints(&arm("left_", 10.0, 9.0), f64::INFINITY, |i| kinds.push(i.kind)),
+            0,
+            "older than the left joints"
+        );
         assert_eq!(kinds, [JointIssue::OutOfOrder; 6]);
         let le = model.joint_index("left_elbow_joint").unwrap();
         assert_eq!(buf.q()[le], 0.4);
@@ -614,13 +634,17 @@ mod tests {
         let base = model.joint_child_frame(yaw);
         let off = (model.frame_placement(base).inverse() * model.frame_placement(f)).translation.vector;
         assert!((conv.points()[0] - Vector2::new(off.x + 1.0, off.y)).norm() < 1e-6);
-        let bad = LaserScan { header: r2r::std_msgs::msg::Header { frame_id: "right_hand".into(), ..Default::default() }, ..msg };
+        let bad = LaserScan {
+            header: r2r::std_msgs::msg::Header { frame_id: "right_hand".into(), ..Default::default() },
+            ..msg
+        };
         assert!(conv.update(&bad).unwrap_err().contains("`right_hand`"));
     }
 
     #[test]
     fn goal_round_trip() {
-        let pose = Isometry3::from_parts(Translation3::new(1.0, 2.0, 3.0), UnitQuaternion::from_euler_angles(0.1, 0.2, 0.3));
+        let pose =
+            Isometry3::from_parts(Translation3::new(1.0, 2.0, 3.0), UnitQuaternion::from_euler_angles(0.1, 0.2, 0.3));
         let back = goal_pose(&write_goal(&pose, &Time::default(), "world")).unwrap();
         assert!((back.to_homogeneous() - pose.to_homogeneous()).norm() < 1e-12);
         let mut msg = write_goal(&pose, &Time::default(), "world");

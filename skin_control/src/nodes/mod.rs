@@ -174,7 +174,12 @@ pub struct SubscriberWait {
 impl SubscriberWait {
     /// Waits as asked (nothing when nothing was asked); `count` gives an output topic's matched
     /// subscribers (`None`: not an output of the node, named in the error with `outputs`).
-    pub fn wait(&self, node: &str, outputs: &[String], count: impl Fn(&str) -> Option<r2r::Result<usize>>) -> Result<()> {
+    pub fn wait(
+        &self,
+        node: &str,
+        outputs: &[String],
+        count: impl Fn(&str) -> Option<r2r::Result<usize>>,
+    ) -> Result<()> {
         if self.wait_topic_subscribers.is_empty() {
             return Ok(());
         }
@@ -193,7 +198,10 @@ impl SubscriberWait {
 /// The topics of `wanted` (`TOPIC`, N) with fewer than N matched subscribers in other processes,
 /// as `TOPIC (n of N)`; `count` gives a topic's count (`None`: not a topic of the caller, an
 /// error).
-pub fn lacking_subscribers(wanted: &[(String, usize)], count: impl Fn(&str) -> Option<r2r::Result<usize>>) -> Result<Vec<String>> {
+pub fn lacking_subscribers(
+    wanted: &[(String, usize)],
+    count: impl Fn(&str) -> Option<r2r::Result<usize>>,
+) -> Result<Vec<String>> {
     let mut lacking = Vec::new();
     for (topic, n_wanted) in wanted {
         let n = count(topic)
@@ -244,7 +252,12 @@ pub fn spin(node: &mut r2r::Node, pool: &mut futures::executor::LocalPool, mut p
 /// can be hundreds of samples behind a lockstep run that goes several times faster than real
 /// time): spins until `taken` (a count of samples handled) has not changed for 100 ms, for at
 /// most `limit`.
-pub fn drain(node: &mut r2r::Node, pool: &mut futures::executor::LocalPool, mut taken: impl FnMut() -> u64, limit: Duration) {
+pub fn drain(
+    node: &mut r2r::Node,
+    pool: &mut futures::executor::LocalPool,
+    mut taken: impl FnMut() -> u64,
+    limit: Duration,
+) {
     let start = std::time::Instant::now();
     let (mut last, mut last_change) = (taken(), start);
     while last_change.elapsed() < Duration::from_millis(100) && start.elapsed() < limit {

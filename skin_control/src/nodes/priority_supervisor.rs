@@ -47,7 +47,13 @@ impl SupervisorHandle {
     pub fn stop(&self) {
         let s = self.sup.borrow();
         let log = s.supervisor().log();
-        r2r::log_info!(&self.logger, "stopping after {} controller states, {} switches; mode {:?}", s.updates(), log.total(), s.supervisor().mode());
+        r2r::log_info!(
+            &self.logger,
+            "stopping after {} controller states, {} switches; mode {:?}",
+            s.updates(),
+            log.total(),
+            s.supervisor().mode()
+        );
     }
 }
 
@@ -66,13 +72,30 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     {
         // The standard parameter services, read-only values (nothing here changes at run time).
         let mut p = node.params.lock().unwrap();
-        p.insert("setup_file".into(), r2r::Parameter { value: ParameterValue::String(setup.clone()), description: "Controller setup file (read at start)" });
-        p.insert("republish_period_s".into(), r2r::Parameter { value: ParameterValue::Double(period), description: "Arrangement republication period [s] (read at start)" });
+        p.insert(
+            "setup_file".into(),
+            r2r::Parameter {
+                value: ParameterValue::String(setup.clone()),
+                description: "Controller setup file (read at start)",
+            },
+        );
+        p.insert(
+            "republish_period_s".into(),
+            r2r::Parameter {
+                value: ParameterValue::Double(period),
+                description: "Arrangement republication period [s] (read at start)",
+            },
+        );
     }
     let (param_services, _changes) = node.make_parameter_handler().context("parameter services")?;
     spawner.spawn_local(param_services)?;
-    let sup = PrioritySupervisor::new(&config.supervisor, ros_now(node)).map_err(|e| anyhow::anyhow!("{setup}: supervisor: {e}"))?;
-    r2r::log_info!(&logger, "{setup}: policy {:?}, {CONTROLLER_STATE} -> {ARRANGEMENT}, service {SET_PHASE}", sup.supervisor().policy());
+    let sup = PrioritySupervisor::new(&config.supervisor, ros_now(node))
+        .map_err(|e| anyhow::anyhow!("{setup}: supervisor: {e}"))?;
+    r2r::log_info!(
+        &logger,
+        "{setup}: policy {:?}, {CONTROLLER_STATE} -> {ARRANGEMENT}, service {SET_PHASE}",
+        sup.supervisor().policy()
+    );
     let sup = Rc::new(RefCell::new(sup));
     let publisher = node.create_publisher::<Arrangement>(super::local(ARRANGEMENT), qos::latched())?;
     let initial = sup.borrow().current();
@@ -86,7 +109,15 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
             let out = s.borrow_mut().on_state(&msg);
             if let Some(a) = out {
                 if let Some(tr) = s.borrow().supervisor().last_transition() {
-                    r2r::log_info!(&log, "t = {:.3} s: {:?} -> {:?} ({:?}): {:?}", tr.t_s, tr.from, tr.to, tr.cause, a.task_order);
+                    r2r::log_info!(
+                        &log,
+                        "t = {:.3} s: {:?} -> {:?} ({:?}): {:?}",
+                        tr.t_s,
+                        tr.from,
+                        tr.to,
+                        tr.cause,
+                        a.task_order
+                    );
                 }
                 if let Err(e) = p.publish(&a) {
                     r2r::log_error!(&log, "{ARRANGEMENT}: {e}");
@@ -111,7 +142,12 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     spawner.spawn_local(async move {
         while let Some(req) = service.next().await {
             let (accepted, message) = s.borrow_mut().request_phase(req.message.phase);
-            r2r::log_info!(&log, "{SET_PHASE} phase {}: {} ({message})", req.message.phase, if accepted { "accepted" } else { "refused" });
+            r2r::log_info!(
+                &log,
+                "{SET_PHASE} phase {}: {} ({message})",
+                req.message.phase,
+                if accepted { "accepted" } else { "refused" }
+            );
             if let Err(e) = req.respond(SetPhase::Response { accepted, message }) {
                 r2r::log_error!(&log, "{SET_PHASE}: reply failed: {e}");
             }

@@ -22,11 +22,15 @@ use super::{file_setting, local, resolve, resolved, ros_now, OnceLog, Timing};
 use crate::convert::robot::time_msg;
 use crate::heartbeat::{self, Commander};
 use crate::lifecycle::{self, Lifecycle};
-use r2r::lifecycle_msgs::msg::{State as StateMsg, Transition, Transition as TransitionMsg, TransitionDescription, TransitionEvent};
-use r2r::lifecycle_msgs::srv::{ChangeState, GetAvailableStates, GetAvailableTransitions, GetState};
 use crate::qos;
 use crate::ros_params::StructParams;
-use crate::task_controller::{Freshness, Idle, InputError, Outputs, TaskController, TaskControllerParams, Trigger, DESCRIPTIONS, START_ONLY};
+use crate::task_controller::{
+    Freshness, Idle, InputError, Outputs, TaskController, TaskControllerParams, Trigger, DESCRIPTIONS, START_ONLY,
+};
+use r2r::lifecycle_msgs::msg::{
+    State as StateMsg, Transition, Transition as TransitionMsg, TransitionDescription, TransitionEvent,
+};
+use r2r::lifecycle_msgs::srv::{ChangeState, GetAvailableStates, GetAvailableTransitions, GetState};
 
 /// Node name.
 pub const NODE: &str = "task_controller";
@@ -126,7 +130,8 @@ impl Shared {
         let out = which(&mut self.tc);
         let sent = self.pubs.send(&out, &self.topics);
         self.beat.stamp = time_msg(now);
-        let sent = sent.and_then(|()| self.heartbeat.publish(&self.beat).map_err(|e| format!("{}: {e}", heartbeat::TOPIC)));
+        let sent =
+            sent.and_then(|()| self.heartbeat.publish(&self.beat).map_err(|e| format!("{}: {e}", heartbeat::TOPIC)));
         if let Err(e) = sent {
             if !std::mem::replace(&mut self.publish_failed, true) {
                 r2r::log_error!(&self.logger, "publishing failed: {e}");
@@ -145,7 +150,9 @@ impl Shared {
             self.command = Command::Active;
         }
         let period = 1.0 / self.tc.params().control_rate_hz;
-        if self.command == Command::Active && self.last_sent_s.is_some_and(|last| now - last > WATCHDOG_PERIODS * period) {
+        if self.command == Command::Active
+            && self.last_sent_s.is_some_and(|last| now - last > WATCHDOG_PERIODS * period)
+        {
             self.beat(now);
             return Period::Silent;
         }
@@ -191,7 +198,11 @@ impl Shared {
             r2r::log_error!(&self.logger, "{why}");
             self.command = Command::Yielded(why);
         } else if self.fault_log.first(1) {
-            r2r::log_warn!(&self.logger, "another task_controller (process {}) heard on the same command topics: it must give way", other.process);
+            r2r::log_warn!(
+                &self.logger,
+                "another task_controller (process {}) heard on the same command topics: it must give way",
+                other.process
+            );
         }
     }
 
@@ -201,7 +212,9 @@ impl Shared {
     fn change_state(&mut self, id: u8, label: &str) -> bool {
         match self.lifecycle.change(id, label) {
             Ok(t) => {
-                let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos() as u64);
+                let stamp = std::time::SystemTime::now()
+                    .duration_since(std::time::UNIX_EPOCH)
+                    .map_or(0, |d| d.as_nanos() as u64);
                 let event = TransitionEvent {
                     timestamp: stamp,
                     transition: TransitionMsg { id: t.id, label: t.label.into() },
@@ -246,7 +259,10 @@ impl Shared {
         self.timing.add(start.elapsed());
         if let Some(f) = self.tc.last_fault() {
             if self.fault_log.first(0) {
-                r2r::log_warn!(&self.logger, "cycle at t = {t_s:.4} s was a safe-stop step: {f} (further ones counted)");
+                r2r::log_warn!(
+                    &self.logger,
+                    "cycle at t = {t_s:.4} s was a safe-stop step: {f} (further ones counted)"
+                );
             }
         }
     }
@@ -372,7 +388,12 @@ fn state_msg(s: lifecycle::State) -> StateMsg {
 /// The managed-node services under `fqn` (change_state, get_state, get_available_states,
 /// get_available_transitions, get_transition_graph). Each request is a few bytes of work: they
 /// are served in the control loop.
-fn serve_lifecycle(node: &mut r2r::Node, spawner: &LocalSpawner, shared: &Rc<RefCell<Shared>>, fqn: &str) -> Result<()> {
+fn serve_lifecycle(
+    node: &mut r2r::Node,
+    spawner: &LocalSpawner,
+    shared: &Rc<RefCell<Shared>>,
+    fqn: &str,
+) -> Result<()> {
     let describe = |t: &lifecycle::Transition| TransitionDescription {
         transition: TransitionMsg { id: t.id, label: t.label.into() },
         start_state: state_msg(t.from),
@@ -387,17 +408,27 @@ fn serve_lifecycle(node: &mut r2r::Node, spawner: &LocalSpawner, shared: &Rc<Ref
     spawn_sub(spawner, get, shared, |s, req| {
         let _ = req.respond(GetState::Response { current_state: state_msg(s.lifecycle.state()) });
     })?;
-    let states = node.create_service::<GetAvailableStates::Service>(&format!("{fqn}/get_available_states"), qos::services())?;
+    let states =
+        node.create_service::<GetAvailableStates::Service>(&format!("{fqn}/get_available_states"), qos::services())?;
     spawn_sub(spawner, states, shared, |_, req| {
-        let _ = req.respond(GetAvailableStates::Response { available_states: lifecycle::State::ALL.map(state_msg).to_vec() });
+        let _ = req
+            .respond(GetAvailableStates::Response { available_states: lifecycle::State::ALL.map(state_msg).to_vec() });
     })?;
-    let available = node.create_service::<GetAvailableTransitions::Service>(&format!("{fqn}/get_available_transitions"), qos::services())?;
+    let available = node.create_service::<GetAvailableTransitions::Service>(
+        &format!("{fqn}/get_available_transitions"),
+        qos::services(),
+    )?;
     spawn_sub(spawner, available, shared, move |s, req| {
-        let _ = req.respond(GetAvailableTransitions::Response { available_transitions: s.lifecycle.available().map(describe).collect() });
+        let _ = req.respond(GetAvailableTransitions::Response {
+            available_transitions: s.lifecycle.available().map(describe).collect(),
+        });
     })?;
-    let graph = node.create_service::<GetAvailableTransitions::Service>(&format!("{fqn}/get_transition_graph"), qos::services())?;
+    let graph = node
+        .create_service::<GetAvailableTransitions::Service>(&format!("{fqn}/get_transition_graph"), qos::services())?;
     spawn_sub(spawner, graph, shared, move |_, req| {
-        let _ = req.respond(GetAvailableTransitions::Response { available_transitions: lifecycle::TRANSITIONS.iter().map(describe).collect() });
+        let _ = req.respond(GetAvailableTransitions::Response {
+            available_transitions: lifecycle::TRANSITIONS.iter().map(describe).collect(),
+        });
     })?;
     Ok(())
 }
@@ -407,21 +438,31 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     let logger = node.logger().to_string();
     let setup = file_setting(node, options.setup, "setup_file", "config/controller/tomm.yaml")?;
     let config = ControllerConfig::load(&resolve(&setup, "setup_file")?).context("controller setup")?;
-    let mut params = StructParams::new(TaskControllerParams::defaults(&config), TaskControllerParams::validate, DESCRIPTIONS)?
-        .with_start_only(START_ONLY)
-        .with_read_only("setup_file", ParameterValue::String(setup.clone()), "Controller setup file (read at start)");
+    let mut params =
+        StructParams::new(TaskControllerParams::defaults(&config), TaskControllerParams::validate, DESCRIPTIONS)?
+            .with_start_only(START_ONLY)
+            .with_read_only(
+                "setup_file",
+                ParameterValue::String(setup.clone()),
+                "Controller setup file (read at start)",
+            );
     params
         .apply_overrides(&node.params.lock().unwrap())
         .context("ROS parameter overrides (--ros-args -p / --params-file)")?;
     let initial = params.value().clone();
     let params = Arc::new(Mutex::new(params));
     let served: Arc<Mutex<dyn RosParams + Send>> = params.clone();
-    let (param_services, mut param_changes) = node.make_derived_parameter_handler(served).context("declaring the parameters")?;
+    let (param_services, mut param_changes) =
+        node.make_derived_parameter_handler(served).context("declaring the parameters")?;
 
-    let tc = TaskController::new(config, initial.clone(), ros_now(node)).map_err(|e| anyhow::anyhow!("{setup}: {e}"))?;
+    let tc =
+        TaskController::new(config, initial.clone(), ros_now(node)).map_err(|e| anyhow::anyhow!("{setup}: {e}"))?;
     let topics: Vec<String> = tc.arms().iter().map(|a| a.topic.clone()).collect();
     let pubs = Publishers {
-        arms: topics.iter().map(|t| node.create_publisher::<Float64MultiArray>(local(t), qos::stream())).collect::<r2r::Result<_>>()?,
+        arms: topics
+            .iter()
+            .map(|t| node.create_publisher::<Float64MultiArray>(local(t), qos::stream()))
+            .collect::<r2r::Result<_>>()?,
         base: if tc.has_base() { Some(node.create_publisher::<Twist>(local(CMD_VEL), qos::stream())?) } else { None },
         state: node.create_publisher::<ControllerState>(local(CONTROLLER_STATE), qos::stream())?,
     };
@@ -431,7 +472,8 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
         all_topics.push(resolved(node, local(CMD_VEL)));
     }
     // Resolved names: the watchdog (in any namespace) zeroes these very topics.
-    let mut described: Vec<String> = tc.arms().iter().map(|a| format!("{}={}", resolved(node, local(&a.topic)), a.joints.len())).collect();
+    let mut described: Vec<String> =
+        tc.arms().iter().map(|a| format!("{}={}", resolved(node, local(&a.topic)), a.joints.len())).collect();
     described.extend(tc.has_base().then(|| resolved(node, local(CMD_VEL))));
     let me = Commander::this_process(&described);
     let beat = Header { stamp: time_msg(0.0), frame_id: me.to_string() };
@@ -491,7 +533,10 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
         s.change_state(Transition::TRANSITION_CONFIGURE as u8, "");
         s.change_state(Transition::TRANSITION_ACTIVATE as u8, "");
     } else {
-        r2r::log_info!(&logger, "holding until activated: ros2 lifecycle set {fqn} configure, then activate (or {fqn}/change_state)");
+        r2r::log_info!(
+            &logger,
+            "holding until activated: ros2 lifecycle set {fqn} configure, then activate (or {fqn}/change_state)"
+        );
     }
     let beats = node.subscribe::<Header>(local(heartbeat::TOPIC), qos::stream())?;
     spawn_sub(spawner, beats, &shared, |s, msg| s.on_heartbeat(&msg))?;
@@ -532,7 +577,13 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     }
     let goal = node.subscribe::<PoseStamped>(local(GOAL), qos::user_input())?;
     spawn_sub(spawner, goal, &shared, |s, msg| match s.tc.on_goal(&msg) {
-        Ok(()) => r2r::log_info!(&s.logger, "{GOAL}: goal ({:.3}, {:.3}, {:.3})", msg.pose.position.x, msg.pose.position.y, msg.pose.position.z),
+        Ok(()) => r2r::log_info!(
+            &s.logger,
+            "{GOAL}: goal ({:.3}, {:.3}, {:.3})",
+            msg.pose.position.x,
+            msg.pose.position.y,
+            msg.pose.position.z
+        ),
         Err(e) => s.refused(Err(e)),
     })?;
     let force = node.subscribe::<Float64>(local(FORCE_REFERENCE), qos::user_input())?;

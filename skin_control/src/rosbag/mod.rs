@@ -17,9 +17,9 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{bail, Context as _, Result};
-use skin_bag::BagWriter;
 use r2r::qos::{DurabilityPolicy, HistoryPolicy, ReliabilityPolicy};
 use r2r::QosProfile;
+use skin_bag::BagWriter;
 
 pub mod play;
 pub mod record;
@@ -181,12 +181,18 @@ pub fn full_definition(type_name: &str) -> Result<String, String> {
     })
 }
 
-const PRIMITIVES: &[&str] =
-    &["bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64", "string", "wstring"];
+const PRIMITIVES: &[&str] = &[
+    "bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64",
+    "uint64", "string", "wstring",
+];
 
 /// `pkg/Type`'s text, then each dependency not yet in `seen` (sorted, depth first) after a line
 /// of 80 `=` and `MSG: pkg/Type`.
-fn ament_definition(type_name: &str, prefixes: &str, seen: &mut std::collections::BTreeSet<String>) -> Result<String, String> {
+fn ament_definition(
+    type_name: &str,
+    prefixes: &str,
+    seen: &mut std::collections::BTreeSet<String>,
+) -> Result<String, String> {
     let (package, ty) = type_name.split_once('/').ok_or_else(|| format!("`{type_name}` is not pkg/Type"))?;
     let text = std::env::split_paths(prefixes)
         .map(|p| p.join("share").join(package).join("msg").join(format!("{ty}.msg")))
@@ -282,23 +288,39 @@ pub fn read_raw(path: &Path) -> Result<RawBag> {
         let message = message.with_context(|| format!("{}: MCAP", path.display()))?;
         let channel = &message.channel;
         if channel.message_encoding != "cdr" {
-            bail!("{}: topic {}: message encoding {:?}, expected \"cdr\"", path.display(), channel.topic, channel.message_encoding);
+            bail!(
+                "{}: topic {}: message encoding {:?}, expected \"cdr\"",
+                path.display(),
+                channel.topic,
+                channel.message_encoding
+            );
         }
         if !bag.topics.contains_key(&channel.topic) {
             let schema = channel.schema.as_ref();
             let type_name = schema.map(|s| s.name.clone()).unwrap_or_default();
-            let type_name = normalize_type(&type_name)
-                .with_context(|| format!("{}: topic {}: schema name `{type_name}` is not a ROS 2 message type", path.display(), channel.topic))?;
+            let type_name = normalize_type(&type_name).with_context(|| {
+                format!(
+                    "{}: topic {}: schema name `{type_name}` is not a ROS 2 message type",
+                    path.display(),
+                    channel.topic
+                )
+            })?;
             bag.topics.insert(
                 channel.topic.clone(),
                 BagTopic {
                     type_name,
                     definition: schema.map(|s| String::from_utf8_lossy(&s.data).into_owned()).unwrap_or_default(),
-                    qos: OfferedQos::parse(channel.metadata.get("offered_qos_profiles").map(String::as_str).unwrap_or("")),
+                    qos: OfferedQos::parse(
+                        channel.metadata.get("offered_qos_profiles").map(String::as_str).unwrap_or(""),
+                    ),
                 },
             );
         }
-        bag.messages.push(RawMessage { topic: channel.topic.clone(), log_time_ns: message.log_time, data: message.data.into_owned() });
+        bag.messages.push(RawMessage {
+            topic: channel.topic.clone(),
+            log_time_ns: message.log_time,
+            data: message.data.into_owned(),
+        });
     }
     bag.messages.sort_by_key(|m| m.log_time_ns);
     Ok(bag)

@@ -103,7 +103,10 @@ pub fn play(options: PlayOptions) -> Result<()> {
     let counted = options.wait_topic_subscribers.iter().map(|(t, _)| t);
     for t in options.topics.iter().chain(&options.latched).chain(&options.step_on).chain(counted) {
         if !bag.topics.contains_key(t) {
-            bail!("{file}: no topic {t} in the bag (it has {})", bag.topics.keys().cloned().collect::<Vec<_>>().join(", "));
+            bail!(
+                "{file}: no topic {t} in the bag (it has {})",
+                bag.topics.keys().cloned().collect::<Vec<_>>().join(", ")
+            );
         }
     }
     let played_topic = |t: &str| {
@@ -122,9 +125,9 @@ pub fn play(options: PlayOptions) -> Result<()> {
     for (name, topic) in bag.topics.iter().filter(|(n, _)| played_topic(n)) {
         let mut qos = topic.qos;
         qos.transient_local |= options.latched.contains(name);
-        let p = node
-            .create_publisher_untyped(name, &topic.type_name, qos.profile())
-            .with_context(|| format!("{file}: {name}: cannot publish type {} (is it one r2r was built with?)", topic.type_name))?;
+        let p = node.create_publisher_untyped(name, &topic.type_name, qos.profile()).with_context(|| {
+            format!("{file}: {name}: cannot publish type {} (is it one r2r was built with?)", topic.type_name)
+        })?;
         pubs.insert(name.clone(), p);
     }
     let clock = if options.clock { Some(node.create_publisher::<Clock>(CLOCK, crate::qos::stream())?) } else { None };
@@ -134,7 +137,13 @@ pub fn play(options: PlayOptions) -> Result<()> {
             let stream = node
                 .subscribe_raw(t, &topic.type_name, topic.qos.profile().volatile())
                 .with_context(|| format!("{t}: cannot subscribe with type {}", topic.type_name))?;
-            Some(Answers { topic: t.clone(), definition: topic.definition.clone(), stream: Box::new(stream), newest: None, count: 0 })
+            Some(Answers {
+                topic: t.clone(),
+                definition: topic.definition.clone(),
+                stream: Box::new(stream),
+                newest: None,
+                count: 0,
+            })
         }
         None => None,
     };
@@ -149,7 +158,12 @@ pub fn play(options: PlayOptions) -> Result<()> {
         Some(answers) => {
             let groups = step_groups(&bag, &played, &answers.topic);
             let steps = groups.iter().filter(|g| g.answered).count();
-            println!("skin_bag: playing {} messages of {file} in {} stamp groups, {steps} answered on {}", played.len(), groups.len(), answers.topic);
+            println!(
+                "skin_bag: playing {} messages of {file} in {} stamp groups, {steps} answered on {}",
+                played.len(),
+                groups.len(),
+                answers.topic
+            );
             for g in &groups {
                 for &i in &g.messages {
                     publish_clock(clock.as_ref(), &bag, i)?;
@@ -200,7 +214,10 @@ pub fn play(options: PlayOptions) -> Result<()> {
 
 fn clock_msg(t_ns: u64) -> Clock {
     Clock {
-        clock: r2r::builtin_interfaces::msg::Time { sec: (t_ns / 1_000_000_000) as i32, nanosec: (t_ns % 1_000_000_000) as u32 },
+        clock: r2r::builtin_interfaces::msg::Time {
+            sec: (t_ns / 1_000_000_000) as i32,
+            nanosec: (t_ns % 1_000_000_000) as u32,
+        },
     }
 }
 
@@ -218,14 +235,22 @@ fn wait_for_subscribers(pubs: &BTreeMap<String, r2r::PublisherUntyped>, options:
     let wanted: Vec<(String, usize)> = pubs
         .keys()
         .map(|name| {
-            let n = options.wait_topic_subscribers.iter().find(|(t, _)| t == name).map_or(options.wait_subscribers, |(_, n)| *n);
+            let n = options
+                .wait_topic_subscribers
+                .iter()
+                .find(|(t, _)| t == name)
+                .map_or(options.wait_subscribers, |(_, n)| *n);
             (name.clone(), n)
         })
         .collect();
     let count = |topic: &str| pubs.get(topic).map(|p| p.get_inter_process_subscription_count());
     let lacking = crate::nodes::wait_for_subscribers(&wanted, count, Duration::from_secs_f64(options.wait_timeout))?;
     if !lacking.is_empty() && !shutdown::requested() {
-        eprintln!("skin_bag: after {} s, too few subscribers on {}: starting anyway", options.wait_timeout, lacking.join(", "));
+        eprintln!(
+            "skin_bag: after {} s, too few subscribers on {}: starting anyway",
+            options.wait_timeout,
+            lacking.join(", ")
+        );
     }
     Ok(())
 }

@@ -60,10 +60,15 @@ pub fn record(options: RecordOptions) -> Result<()> {
         if options.latched.contains(name) {
             qos = qos.transient_local();
         }
-        let stream = node
-            .subscribe_raw(name, type_name, qos)
-            .with_context(|| format!("{name}: cannot subscribe with type {type_name} (is it one r2r was built with?)"))?;
-        topics.push(Recorded { name: name.clone(), type_name: type_name.clone(), registered: false, stream: Box::new(stream) });
+        let stream = node.subscribe_raw(name, type_name, qos).with_context(|| {
+            format!("{name}: cannot subscribe with type {type_name} (is it one r2r was built with?)")
+        })?;
+        topics.push(Recorded {
+            name: name.clone(),
+            type_name: type_name.clone(),
+            registered: false,
+            stream: Box::new(stream),
+        });
     }
     let list: Vec<String> = types.iter().map(|(n, t)| format!("{n} ({t})")).collect();
     println!("skin_bag: recording {} topics to {}: {}", types.len(), options.out.display(), list.join(", "));
@@ -132,7 +137,12 @@ fn resolve_types(node: &mut r2r::Node, options: &RecordOptions) -> Result<Vec<(S
                     out.push((spec.name.clone(), t));
                 }
                 Some(many) if many.len() > 1 => {
-                    bail!("{}: published with several types ({}): give one as {}:pkg/msg/Type", spec.name, many.join(", "), spec.name)
+                    bail!(
+                        "{}: published with several types ({}): give one as {}:pkg/msg/Type",
+                        spec.name,
+                        many.join(", "),
+                        spec.name
+                    )
                 }
                 _ => missing.push(spec.name.as_str()),
             }

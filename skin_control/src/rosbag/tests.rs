@@ -63,7 +63,10 @@ fn raw_bag_round_trips_bytes_types_and_qos() {
     w.finish().unwrap();
     let bag = read_raw(&path).unwrap();
     std::fs::remove_file(&path).ok();
-    assert_eq!(bag.messages.iter().map(|m| (m.topic.as_str(), m.log_time_ns)).collect::<Vec<_>>(), [("/base/cmd_vel", 10), ("/joint_states", 20)]);
+    assert_eq!(
+        bag.messages.iter().map(|m| (m.topic.as_str(), m.log_time_ns)).collect::<Vec<_>>(),
+        [("/base/cmd_vel", 10), ("/joint_states", 20)]
+    );
     assert_eq!(bag.messages[0].data, [0, 1, 0, 0, 7]);
     assert!(bag.topics["/base/cmd_vel"].qos.transient_local);
     assert!(!bag.topics["/joint_states"].qos.transient_local);
@@ -102,14 +105,21 @@ fn unknown_types_are_named_with_the_topic() {
 }
 
 fn msg(topic: &str, t: u64, stamp: Option<i32>) -> RawMessage {
-    RawMessage { topic: topic.into(), log_time_ns: t, data: stamp.map_or(vec![0, 1, 0, 0, 0, 0, 0, 0], |s| cdr_stamp(s, 0, &[])) }
+    RawMessage {
+        topic: topic.into(),
+        log_time_ns: t,
+        data: stamp.map_or(vec![0, 1, 0, 0, 0, 0, 0, 0], |s| cdr_stamp(s, 0, &[])),
+    }
 }
 
 #[test]
 fn step_groups_follow_stamps_not_arrival() {
     let mut bag = RawBag::default();
     for (t, def) in [("/a", JOINT_STATE), ("/b", JOINT_STATE), ("/f", FLOAT64), ("/state", JOINT_STATE)] {
-        bag.topics.insert(t.into(), BagTopic { type_name: "x/msg/Y".into(), definition: def.into(), qos: OfferedQos::default() });
+        bag.topics.insert(
+            t.into(),
+            BagTopic { type_name: "x/msg/Y".into(), definition: def.into(), qos: OfferedQos::default() },
+        );
     }
     // Recorded arrival: /a(1) before /b(0) (two readers, no order between topics).
     bag.messages = vec![

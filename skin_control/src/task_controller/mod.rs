@@ -4,7 +4,7 @@
 //!
 //! Inputs (docs/ros.md): `/joint_states` (arm joints by name), `/base/odom` (when the model has a
 //! base), `/skin/cells` (when the layout has cells; per cell, because avoidance and contact
-//! reaction act per cell, paper 000 eq. 3-6), `/scan` (when `use_scan`), `/goal`, the hand force
+//! reaction act per cell, intentional-contact paper eq. 3-6), `/scan` (when `use_scan`), `/goal`, the hand force
 //! reference (newtons), `/supervisor/arrangement`. A cycle runs only on a complete input set
 //! (every required input received at least once); until then, and whenever the inputs go stale,
 //! the commands are zero.
@@ -16,18 +16,18 @@ use r2r::sensor_msgs::msg::{JointState, LaserScan};
 use r2r::skin_msgs::msg::{Arrangement as ArrangementMsg, ControllerState};
 use r2r::std_msgs::msg::Float64MultiArray;
 use serde::{Deserialize, Serialize};
+use skin_core::controller::HandForceMap;
 use skin_core::controller::{Controller, ControllerConfig, ControllerInput};
 use skin_core::model::{frame_pose, update_kinematics, ModelData};
 use skin_core::skin::params::SkinParams;
 use skin_core::supervisor::Mode;
 use skin_core::tasks::params::TaskParams;
-use skin_core::controller::HandForceMap;
 
+use crate::convert::cdr_cells::CdrCells;
 use crate::convert::control::{
     imposed_of, split_arms, twist_msg, write_arm_command, write_controller_state, ArmCommand,
 };
 use crate::convert::robot::{goal_pose, time_s, JointIssue, JointStateIssue, ScanConverter, StateBuffer};
-use crate::convert::cdr_cells::CdrCells;
 use crate::convert::{update_cells, CellBuffer, CellMessage, Issue, IssueKind};
 use crate::input_health::{fresh, IssueTable, StampGate, StampIssue};
 use crate::nodes::topics::{ARRANGEMENT, CELLS, FORCE_REFERENCE, GOAL, JOINT_STATES, ODOM, SCAN};
@@ -76,7 +76,10 @@ impl ArmsParams {
     pub fn for_joints(names: &[String]) -> Self {
         let two = ["left_", "right_"].iter().all(|p| names.iter().any(|n| n.starts_with(p)));
         if two {
-            ArmsParams { namespaces: vec!["left_arm".into(), "right_arm".into()], joint_prefixes: vec!["left_".into(), "right_".into()] }
+            ArmsParams {
+                namespaces: vec!["left_arm".into(), "right_arm".into()],
+                joint_prefixes: vec!["left_".into(), "right_".into()],
+            }
         } else {
             ArmsParams { namespaces: vec!["arm".into()], joint_prefixes: vec![String::new()] }
         }
@@ -95,7 +98,7 @@ pub struct TaskControllerParams {
     pub trigger: Trigger,
     /// `topic` or `internal` ([`SupervisorSource`]).
     pub supervisor: SupervisorSource,
-    /// Whether `/scan` is a required input (base avoidance, paper 003 eq. 15-17).
+    /// Whether `/scan` is a required input (base avoidance, interactive-force-control paper eq. 15-17).
     pub use_scan: bool,
     /// Timer mode: joint states older than this (ROS time; per joint) make the commands ramp to
     /// zero \[s\].
@@ -125,7 +128,17 @@ pub struct TaskControllerParams {
 
 /// Keys that only the start reads (everything but the timeouts and `max_stamp_lead_s`): the
 /// controller is built from them once (`skin_core::controller::Controller` has no setter for them at run time).
-pub const START_ONLY: &[&str] = &["control_rate_hz", "trigger", "supervisor", "use_scan", "autostart", "commander_wait_s", "arms.", "skin.", "tasks."];
+pub const START_ONLY: &[&str] = &[
+    "control_rate_hz",
+    "trigger",
+    "supervisor",
+    "use_scan",
+    "autostart",
+    "commander_wait_s",
+    "arms.",
+    "skin.",
+    "tasks.",
+];
 
 /// `ros2 param describe` texts.
 pub const DESCRIPTIONS: &[(&str, &str)] = &[
@@ -284,13 +297,21 @@ impl Health {
         let mut table = IssueTable::default();
         let joint_kinds = table.register(JOINT_STATES, JointIssue::ALL.map(JointIssue::name));
         let cell_kinds = table.register(CELLS, IssueKind::ALL.map(IssueKind::name));
-        let stamps = TIMED_TOPICS.map(|t| (StampGate::default(), table.register(t, StampIssue::ALL.map(StampIssue::name))));
-        let refused = [CELLS, ODOM, SCAN, GOAL, FORCE_REFERENCE, ARRANGEMENT].map(|t| (t, table.register(t, [REFUSED])));
+        let stamps =
+            TIMED_TOPICS.map(|t| (StampGate::default(), table.register(t, StampIssue::ALL.map(StampIssue::name))));
+        let refused =
+            [CELLS, ODOM, SCAN, GOAL, FORCE_REFERENCE, ARRANGEMENT].map(|t| (t, table.register(t, [REFUSED])));
         Health { table, joint_kinds, cell_kinds, stamps, refused, idle_periods: 0 }
     }
 
     /// The stamp check of `input` (`now_s`: the clock to compare with, if any).
-    fn check_stamp(&mut self, input: Timed, stamp: &Time, now_s: Option<f64>, max_lead_s: f64) -> Result<(), InputError> {
+    fn check_stamp(
+        &mut self,
+        input: Timed,
+        stamp: &Time,
+        now_s: Option<f64>,
+        max_lead_s: f64,
+    ) -> Result<(), InputError> {
         let gate = &self.stamps[input as usize].0;
         gate.check(stamp, now_s, max_lead_s).map_err(|issue| self.stamp_issue(input, issue, stamp, now_s))
     }
@@ -357,7 +378,12 @@ impl TaskController {
         let controller = Controller::new(config, t0_s).map_err(|e| e.to_string())?;
         let cfg = controller.config();
         let model = &cfg.model;
-        let arms = split_arms(model.joint_names(), controller.resolver().arm_joints(), &params.arms.namespaces, &params.arms.joint_prefixes)?;
+        let arms = split_arms(
+            model.joint_names(),
+            controller.resolver().arm_joints(),
+            &params.arms.namespaces,
+            &params.arms.joint_prefixes,
+        )?;
         let state = StateBuffer::new(model);
         let scan = ScanConverter::new(model);
         Ok(TaskController {
@@ -365,11 +391,14 @@ impl TaskController {
             needs_cells: cfg.layout.num_cells() > 0,
             cells: CellBuffer::new(&cfg.layout),
             cdr_cells: CdrCells::default(),
-            arm_msgs: arms.iter().map(|a| {
-                let mut m = Float64MultiArray::default();
-                write_arm_command(a, &[], &mut m);
-                m
-            }).collect(),
+            arm_msgs: arms
+                .iter()
+                .map(|a| {
+                    let mut m = Float64MultiArray::default();
+                    write_arm_command(a, &[], &mut m);
+                    m
+                })
+                .collect(),
             twist: Twist::default(),
             state_msg: ControllerState::default(),
             state,
@@ -416,7 +445,8 @@ impl TaskController {
     /// the parameter server holds now.
     pub fn take_settable(&mut self, p: &TaskControllerParams) {
         let q = &mut self.params;
-        (q.input_timeout_s, q.odom_timeout_s, q.cells_timeout_s, q.scan_timeout_s) = (p.input_timeout_s, p.odom_timeout_s, p.cells_timeout_s, p.scan_timeout_s);
+        (q.input_timeout_s, q.odom_timeout_s, q.cells_timeout_s, q.scan_timeout_s) =
+            (p.input_timeout_s, p.odom_timeout_s, p.cells_timeout_s, p.scan_timeout_s);
         q.max_stamp_lead_s = p.max_stamp_lead_s;
     }
 
@@ -445,7 +475,12 @@ impl TaskController {
     /// `/joint_states` at node time `now_s`; `report` gets the first issue of each kind (all are
     /// counted). Each joint is written only with finite values and a stamp not older than its
     /// own; a message that writes no joint because of its stamp is refused.
-    pub fn on_joint_states(&mut self, msg: &JointState, now_s: f64, mut report: impl FnMut(&JointStateIssue)) -> Result<(), InputError> {
+    pub fn on_joint_states(
+        &mut self,
+        msg: &JointState,
+        now_s: f64,
+        mut report: impl FnMut(&JointStateIssue),
+    ) -> Result<(), InputError> {
         let lead = self.params.max_stamp_lead_s;
         let clock = self.clock(now_s);
         let stamp = &msg.header.stamp;
@@ -480,7 +515,12 @@ impl TaskController {
     }
 
     /// `/skin/cells` at node time `now_s`; `report` gets the first issue of each kind.
-    pub fn on_cells(&mut self, msg: &impl CellMessage, now_s: f64, mut report: impl FnMut(&Issue)) -> Result<(), InputError> {
+    pub fn on_cells(
+        &mut self,
+        msg: &impl CellMessage,
+        now_s: f64,
+        mut report: impl FnMut(&Issue),
+    ) -> Result<(), InputError> {
         let lead = self.params.max_stamp_lead_s;
         let stamp = msg.stamp();
         self.health.check_stamp(Timed::Cells, &stamp, self.clock(now_s), lead)?;
@@ -534,18 +574,23 @@ impl TaskController {
         }
         let model = &self.controller.config().model;
         let Some(frame) = model.frame_index(name) else {
-            return Err(format!("header.frame_id `{name}`: not {WORLD_FRAME}, {ODOM_FRAME} or a link of the robot's URDF"));
+            return Err(format!(
+                "header.frame_id `{name}`: not {WORLD_FRAME}, {ODOM_FRAME} or a link of the robot's URDF"
+            ));
         };
         if !self.state.complete() {
             let missing = self.missing().join(", ");
-            return Err(format!("header.frame_id `{name}`: the robot's state is not known yet (waiting for {missing})"));
+            return Err(format!(
+                "header.frame_id `{name}`: the robot's state is not known yet (waiting for {missing})"
+            ));
         }
         let mut data = ModelData::new(model);
-        update_kinematics(model, &mut data, self.state.q(), self.state.qd()).map_err(|e| format!("header.frame_id `{name}`: {e}"))?;
+        update_kinematics(model, &mut data, self.state.q(), self.state.qd())
+            .map_err(|e| format!("header.frame_id `{name}`: {e}"))?;
         Ok(*frame_pose(&data, frame))
     }
 
-    /// The hand force reference \[N\], mapped to the hand signal `f_c,d` of paper 003 eq. (9)
+    /// The hand force reference \[N\], mapped to the hand signal `f_c,d` of interactive-force-control paper eq. (9)
     /// by `skin_core::controller::HandForceMap` (an even contact on the palm cells). Returns the
     /// signal given.
     pub fn on_force_reference(&mut self, force_n: f64) -> Result<f64, InputError> {
@@ -557,7 +602,9 @@ impl TaskController {
             return Err(self.health.refuse(FORCE_REFERENCE)(format!("data = {force_n}: must be finite and >= 0 N")));
         }
         let signal = map.signal(force_n);
-        self.controller.set_hand_force_reference(signal).map_err(|f| self.health.refuse(FORCE_REFERENCE)(f.to_string()))?;
+        self.controller
+            .set_hand_force_reference(signal)
+            .map_err(|f| self.health.refuse(FORCE_REFERENCE)(f.to_string()))?;
         Ok(signal)
     }
 
@@ -579,7 +626,8 @@ impl TaskController {
 
     /// The required inputs that have not arrived yet (empty: complete).
     pub fn missing(&self) -> Vec<String> {
-        let mut m: Vec<String> = self.state.missing().filter(|n| !self.is_base_joint(n)).map(|n| format!("joint `{n}`")).collect();
+        let mut m: Vec<String> =
+            self.state.missing().filter(|n| !self.is_base_joint(n)).map(|n| format!("joint `{n}`")).collect();
         if self.needs_odom && self.state.odom_time().is_none() {
             m.push("odometry".into());
         }
@@ -692,7 +740,14 @@ impl TaskController {
         self.twist = twist_msg(out.commands.base_twist);
         let c = &self.controller;
         let sup = c.supervisor();
-        write_controller_state(c.output(), sup.tasks(), sup.arrangement().task_order(), c.level_diagnostics(), stamp, &mut self.state_msg);
+        write_controller_state(
+            c.output(),
+            sup.tasks(),
+            sup.arrangement().task_order(),
+            c.level_diagnostics(),
+            stamp,
+            &mut self.state_msg,
+        );
         self.state_msg.input_status = ControllerState::INPUT_FRESH as u8;
         self.write_health();
         self.last_cycle = Some(stamp.clone());

@@ -21,7 +21,8 @@ fn controller() -> TaskController {
     params.supervisor = SupervisorSource::Internal;
     params.control_rate_hz = RATE_HZ;
     let mut tc = TaskController::new(config, params, 0.0).unwrap();
-    let goal = Isometry3::from_parts(Translation3::new(1.0, -0.6, 0.0), UnitQuaternion::from_euler_angles(0.0, 0.0, 1.57));
+    let goal =
+        Isometry3::from_parts(Translation3::new(1.0, -0.6, 0.0), UnitQuaternion::from_euler_angles(0.0, 0.0, 1.57));
     tc.on_goal(&write_goal(&goal, &time_msg(0.0), "world")).unwrap();
     tc
 }
@@ -259,7 +260,8 @@ fn two_drivers_with_their_own_stamps_are_both_accepted() {
         let t = 1.0 + 0.008 * k as f64;
         q[6] = 0.1 + 0.001 * k as f64;
         tc.on_joint_states(&some_joints(&tc, t, 0..4, &q), t, |_| {}).unwrap();
-        tc.on_joint_states(&some_joints(&tc, t - 0.02, 4..7, &q), t, |_| panic!("an issue with the lagging driver")).unwrap();
+        tc.on_joint_states(&some_joints(&tc, t - 0.02, 4..7, &q), t, |_| panic!("an issue with the lagging driver"))
+            .unwrap();
         tc.on_cells(&cells(t, &[]), t, |_| {}).unwrap();
         assert_eq!(tc.freshness(t), Freshness::Fresh);
         assert_eq!(tc.state.q()[6], q[6], "the lagging driver's joint is written");

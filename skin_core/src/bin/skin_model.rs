@@ -11,8 +11,8 @@ use nalgebra::{DMatrix, DVector, Matrix6xX, Vector3, Vector6};
 use serde::Deserialize;
 use serde_json::{json, Value};
 use skin_core::model::{
-    bias_forces, crba, gravity, point_jacobian, point_jacobian_dot_qdot, update_kinematics, MimicMode, ModelData, RobotModel,
-    UrdfOptions,
+    bias_forces, crba, gravity, point_jacobian, point_jacobian_dot_qdot, update_kinematics, MimicMode, ModelData,
+    RobotModel, UrdfOptions,
 };
 
 /// Evaluate kinematics and dynamics of a URDF robot model and print one JSON document.
@@ -132,11 +132,7 @@ impl<'a> Evaluator<'a> {
         let frame = match link {
             None => None,
             Some(name) => Some(model.frame_index(name).ok_or_else(|| {
-                anyhow!(
-                    "unknown link `{name}` in {}; known links: {}",
-                    model.source(),
-                    model.frame_names().join(", ")
-                )
+                anyhow!("unknown link `{name}` in {}; known links: {}", model.source(), model.frame_names().join(", "))
             })?),
         };
         update_kinematics(model, &mut self.data, q, qd)?;
@@ -179,8 +175,8 @@ fn run(args: Args) -> Result<Value> {
     let mut ev = Evaluator::new(&model);
     if let Some(batch) = &args.batch {
         let text = std::fs::read_to_string(batch).with_context(|| format!("cannot read {}", batch.display()))?;
-        let states: Vec<State> =
-            serde_json::from_str(&text).with_context(|| format!("{}: expected a JSON list of states", batch.display()))?;
+        let states: Vec<State> = serde_json::from_str(&text)
+            .with_context(|| format!("{}: expected a JSON list of states", batch.display()))?;
         let mut results = Vec::with_capacity(states.len());
         for (i, s) in states.iter().enumerate() {
             let r = ev

@@ -2,8 +2,8 @@
 //!
 //! A spherical fingertip approaches (or presses on) the skin of a link at a chosen cell; the
 //! command derives every cell's proximity and force signals through the skin characteristics,
-//! then reports what the controllers will see: the patch wrenches of paper 003 eq. (6)-(8) and
-//! the joint torques of paper 000 eq. (3)-(4) (proximity repulsion), eq. (6) (contact) and paper
+//! then reports what the controllers will see: the patch wrenches of interactive-force-control paper eq. (6)-(8) and
+//! the joint torques of intentional-contact paper eq. (3)-(4) (proximity repulsion), eq. (6) (contact) and paper
 //! 003 eq. (13)-(14) (patch wrenches).
 //!
 //! ```text
@@ -120,9 +120,8 @@ fn run(a: Args) -> Result<()> {
     point_forces_to_torques(&model, &data, &contact, &mut tau_c);
     patch_wrenches_to_torques(&model, &data, &layout, &wrenches, |_| true, &mut tau_skin);
 
-    let touched: Vec<usize> = (0..readings.len())
-        .filter(|&i| readings[i].proximity > 0.0 || readings[i].force[0] > 0.0)
-        .collect();
+    let touched: Vec<usize> =
+        (0..readings.len()).filter(|&i| readings[i].proximity > 0.0 || readings[i].force[0] > 0.0).collect();
     if a.json {
         let patches: Vec<_> = active_patches(&wrenches)
             .map(|(j, w)| {
@@ -150,7 +149,7 @@ fn run(a: Args) -> Result<()> {
         a.force,
         touched.len()
     );
-    println!("\npatch wrenches (patch frame, fused signal units, paper 003 eq. 6-8):");
+    println!("\npatch wrenches (patch frame, fused signal units, interactive-force-control paper eq. 6-8):");
     println!("  {:>5} {:<24} {:>6} {:>26} {:>26}", "patch", "link", "active", "force", "moment");
     for (j, w) in active_patches(&wrenches) {
         println!(
@@ -175,14 +174,12 @@ fn run(a: Args) -> Result<()> {
 /// The cell the touch is centred on: --cell, or the first cell on --link.
 fn target_cell(a: &Args, model: &RobotModel, layout: &ResolvedLayout) -> Result<usize> {
     if let Some(id) = a.cell {
-        return layout
-            .cell_index(id)
-            .ok_or_else(|| anyhow!("no cell with id {id} in {}", layout.source()));
+        return layout.cell_index(id).ok_or_else(|| anyhow!("no cell with id {id} in {}", layout.source()));
     }
     let link = a.link.as_deref().unwrap_or_default();
-    let frame = model.frame_index(link).ok_or_else(|| {
-        anyhow!("no link '{link}' in {}; links: {}", model.source(), model.frame_names().join(", "))
-    })?;
+    let frame = model
+        .frame_index(link)
+        .ok_or_else(|| anyhow!("no link '{link}' in {}; links: {}", model.source(), model.frame_names().join(", ")))?;
     layout
         .cells()
         .iter()

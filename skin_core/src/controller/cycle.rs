@@ -23,15 +23,15 @@ fn stage<E>(name: &'static str) -> impl FnOnce(E) -> Fault {
 /// The whole control law of both papers behind one call per cycle:
 ///
 /// 1. kinematics at the measured state; the supervisor's signals (end-effector speed, `‖F_d‖` at
-///    the nominal range, `‖F_c‖`, goal error) and its arrangement (paper 000 Table I or paper 003
+///    the nominal range, `‖F_c‖`, goal error) and its arrangement (intentional-contact paper Table I or interactive-force-control paper
 ///    Table 1);
-/// 2. the skin: cells fused with the arrangement's weight `w(t)` (paper 003 eq. 6) into patch
+/// 2. the skin: cells fused with the arrangement's weight `w(t)` (interactive-force-control paper eq. 6) into patch
 ///    wrenches (eq. 7-8), and the hand signals of eq. (9)-(11);
 /// 3. the arrangement's tasks filled in priority order, the posture torque of eq. (18) with the
-///    terms the arrangement names, solved by the hierarchy (paper 003 eq. 19-25, with the bias
+///    terms the arrangement names, solved by the hierarchy (interactive-force-control paper eq. 19-25, with the bias
 ///    `C q̇ + g`);
-/// 4. the torque blended across arrangement switches (paper 000 eq. 10-11);
-/// 5. the admittance resolver (paper 003 eq. 26) turns it into joint and base velocity commands
+/// 4. the torque blended across arrangement switches (intentional-contact paper eq. 10-11);
+/// 5. the admittance resolver (interactive-force-control paper eq. 26) turns it into joint and base velocity commands
 ///    within the limits.
 ///
 /// Bad input (wrong lengths, NaN state, bad `dt`) or a failed stage makes the cycle a safe-stop
@@ -83,7 +83,8 @@ impl Controller {
         let model = &config.model;
         let nv = model.nv();
         let ee = model.frame_index(&config.setup.end_effector).ok_or_else(|| {
-            config.invalid("end_effector", format!("frame `{}` is not in {}", config.setup.end_effector, model.source()))
+            config
+                .invalid("end_effector", format!("frame `{}` is not in {}", config.setup.end_effector, model.source()))
         })?;
         if !config.setup.posture.is_empty() && config.setup.posture.len() != nv {
             let reason = format!("has {} values, the model has {nv} joints", config.setup.posture.len());
@@ -95,16 +96,18 @@ impl Controller {
         let body_patches = hand_patches.iter().map(|h| !h).collect();
         let mut locked = vec![false; nv];
         for (i, name) in config.setup.locked_joints.iter().enumerate() {
-            let j = model
-                .joint_index(name)
-                .ok_or_else(|| config.invalid(format!("locked_joints[{i}]"), format!("joint `{name}` is not in {}", model.source())))?;
+            let j = model.joint_index(name).ok_or_else(|| {
+                config.invalid(format!("locked_joints[{i}]"), format!("joint `{name}` is not in {}", model.source()))
+            })?;
             locked[j] = true;
         }
         let tasks = TaskSet::new(&config, ee)?;
         let max_rows = tasks.levels.iter().map(|l| l.max_rows()).max().unwrap_or(0);
         let mut solver = HierarchySolver::new(nv, tasks.levels.len(), max_rows, config.setup.inverse)
             .map_err(|error| SetupError::Inverse { file: config.source.clone(), error })?;
-        solver.set_locked_joints(&locked).map_err(|error| SetupError::Inverse { file: config.source.clone(), error })?;
+        solver
+            .set_locked_joints(&locked)
+            .map_err(|error| SetupError::Inverse { file: config.source.clone(), error })?;
         let resolver = Resolver::new(model, config.resolver.clone())
             .map_err(|error| SetupError::Resolver { file: config.setup.resolver.display().to_string(), error })?;
         let supervisor = Supervisor::new(&config.supervisor, t0_s)?;
@@ -174,7 +177,7 @@ impl Controller {
         self.goal.as_ref()
     }
 
-    /// Sets the desired fused hand signal `f_c,d` of paper 003 eq. (9): the hand patches' summed
+    /// Sets the desired fused hand signal `f_c,d` of interactive-force-control paper eq. (9): the hand patches' summed
     /// virtual force along the hand's z axis (eq. 7: a sum over the active cells, so up to the
     /// number of hand cells), clamped to `[0, hand cells]`; NaN is refused.
     pub fn set_hand_force_reference(&mut self, signal: f64) -> Result<(), Fault> {
@@ -182,12 +185,13 @@ impl Controller {
             return Err(Fault::NonFinite { input: "hand force reference", index: 0 });
         }
         let layout = &self.config.layout;
-        let hand_cells: usize = layout.patches().iter().zip(&self.hand_patches).filter(|(_, &h)| h).map(|(p, _)| p.cells.len()).sum();
+        let hand_cells: usize =
+            layout.patches().iter().zip(&self.hand_patches).filter(|(_, &h)| h).map(|(p, _)| p.cells.len()).sum();
         self.tasks.set_hand_force_reference(signal.clamp(0.0, hand_cells as f64));
         Ok(())
     }
 
-    /// Sets the commanded base motion (paper 003 Exp. 1: a circle, lateral swings): the moving
+    /// Sets the commanded base motion (interactive-force-control paper Exp. 1: a circle, lateral swings): the moving
     /// target `q_d(t)`, `q̇_d(t)` of the base joints in the posture torque of eq. (18), the lowest
     /// level, so the higher levels keep the hand while the base follows; `None`: back to
     /// `q_post`. Call it every cycle with the reference for that cycle's time. Refused: a
@@ -210,7 +214,7 @@ impl Controller {
         self.tasks.posture.base_reference()
     }
 
-    /// Requests a paper 003 phase (effective at the next update).
+    /// Requests a interactive-force-control paper phase (effective at the next update).
     pub fn request_phase(&mut self, phase: Phase) -> Result<(), PhaseRefused> {
         self.supervisor.request_phase(phase)
     }
@@ -328,7 +332,7 @@ impl Controller {
         self.output.signals = signals;
         self.supervisor.update(input.t_s, &signals);
         if first || self.supervisor.last_transition().is_some() {
-            self.tasks.hold.capture(&self.data); // x_ef,init of paper 003 Table 1's contact phase
+            self.tasks.hold.capture(&self.data); // x_ef,init of interactive-force-control paper Table 1's contact phase
         }
         let arrangement = self.supervisor.arrangement();
         let model = &self.config.model;
@@ -337,7 +341,8 @@ impl Controller {
         self.fusion.weight_force = arrangement.fusion_weight;
         self.output.fusion_weight = arrangement.fusion_weight;
         let layout = &self.config.layout;
-        aggregate_live_patches(layout, &self.live, &self.fusion, &mut self.wrenches).map_err(stage("skin aggregation"))?;
+        aggregate_live_patches(layout, &self.live, &self.fusion, &mut self.wrenches)
+            .map_err(stage("skin aggregation"))?;
         let data = &self.data;
         // the hand signals read the hand and guidance patches' poses only
         let (hand, guidance) = (&self.hand_patches, &self.guidance_patches);
@@ -379,7 +384,9 @@ impl Controller {
             *g = 0.0; // a locked joint's virtual dynamics stay at rest (its τ* is 0)
         }
         match self.config.setup.hierarchy_dynamics {
-            HierarchyDynamics::Model => self.solver.solve_model(model, &mut self.data, active, posture, true, &mut self.tau_k),
+            HierarchyDynamics::Model => {
+                self.solver.solve_model(model, &mut self.data, active, posture, true, &mut self.tau_k)
+            }
             HierarchyDynamics::Admittance => {
                 self.resolver.virtual_dynamics(input.q, input.qd, input.dt_s, &mut self.mass, &mut self.bias);
                 for (j, _) in self.locked.iter().enumerate().filter(|(_, &l)| l) {
@@ -419,11 +426,15 @@ impl Controller {
         let (skin, layout) = (&config.skin, &config.layout);
         let nominal = config.supervisor.sensing_range.nominal_m;
         let avoid = self.tasks.avoidance.summarize(layout, &self.live, nominal).map_err(stage("avoidance"))?;
-        let contact = self.tasks.contact.summarize(layout, &self.live, &skin.fusion).map_err(stage("contact reaction"))?;
-        let speed = point_velocity(model, data, self.ee, &nalgebra::Vector3::zeros()).map_err(stage("end-effector velocity"))?.norm();
-        let goal_error = self.goal.as_ref().map_or(f64::NAN, |g| {
-            (g.translation.vector - data.frame_pose(self.ee).translation.vector).norm()
-        });
+        let contact =
+            self.tasks.contact.summarize(layout, &self.live, &skin.fusion).map_err(stage("contact reaction"))?;
+        let speed = point_velocity(model, data, self.ee, &nalgebra::Vector3::zeros())
+            .map_err(stage("end-effector velocity"))?
+            .norm();
+        let goal_error = self
+            .goal
+            .as_ref()
+            .map_or(f64::NAN, |g| (g.translation.vector - data.frame_pose(self.ee).translation.vector).norm());
         Ok(SupervisorInput {
             ee_speed_mps: speed,
             avoidance_force_n: avoid.force_norm_n,
@@ -432,7 +443,7 @@ impl Controller {
         })
     }
 
-    /// Paper 003 eq. (9)-(11) inputs from the patch wrenches of this cycle.
+    /// Interactive-force-control paper eq. (9)-(11) inputs from the patch wrenches of this cycle.
     fn hand_signals(&self) -> HandSignals {
         let hand_pose = self.data.frame_pose(self.ee);
         let (poses, wrenches) = (&self.patch_poses, &self.wrenches);

@@ -1,4 +1,4 @@
-//! Force references in newtons to the hand signal `f_c,d` of paper 003 eq. (9).
+//! Force references in newtons to the hand signal `f_c,d` of interactive-force-control paper eq. (9).
 //!
 //! The controller regulates `f_c`, the z component (hand frame) of the hand patches' force of
 //! eq. (7): the sum of the active cells' fused signals along their normals. In the contact phase
@@ -16,9 +16,9 @@
 //! an uneven distribution reads lower for the same force: the measured newtons (MuJoCo's
 //! contacts, measured by skin_sim's probe) tell how good the assumption is.
 
-use nalgebra::Vector3;
 use super::ControllerConfig;
 use crate::skin::characteristic::PreparedForce;
+use nalgebra::Vector3;
 
 /// A cell counts as facing along the palm normal when `n_i · z_h` exceeds this (within ~25°).
 const FACING_COS: f64 = 0.9;
@@ -49,10 +49,7 @@ impl HandForceMap {
                 normal.dot(&Vector3::z()) > FACING_COS
             })
             .count();
-        (cells > 0).then(|| HandForceMap {
-            cells,
-            force: config.skin.force.prepared(),
-        })
+        (cells > 0).then(|| HandForceMap { cells, force: config.skin.force.prepared() })
     }
 
     /// Number of hand cells facing along the palm normal (`n`).

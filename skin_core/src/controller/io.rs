@@ -70,18 +70,18 @@ pub struct ControllerOutput {
     pub fault: Option<Fault>,
     /// The active arrangement's mode.
     pub mode: Mode,
-    /// `χ` of paper 000 eq. (10)-(11): the weight of the previous arrangement's torque (0: no
+    /// `χ` of intentional-contact paper eq. (10)-(11): the weight of the previous arrangement's torque (0: no
     /// blend in progress).
     pub blend: f64,
-    /// Fusion weight `w(t)` of paper 003 eq. (6) the skin was fused with this cycle.
+    /// Fusion weight `w(t)` of interactive-force-control paper eq. (6) the skin was fused with this cycle.
     pub fusion_weight: f64,
     /// The signals the supervisor decided on (ee speed, `‖F_d‖` at the nominal range, `‖F_c‖`,
     /// goal error; the goal error is NaN without a goal).
     pub signals: SupervisorInput,
     /// `‖τ*‖` of the blended torque \[N m\].
     pub torque_norm: f64,
-    /// `ʰΓ` of paper 003 eq. (10): the hand patches' summed moment in the hand frame `{h}`
+    /// `ʰΓ` of interactive-force-control paper eq. (10): the hand patches' summed moment in the hand frame `{h}`
     /// (normalized-signal units times metres, like the patch wrenches of eq. 8); zero without hand
-    /// patches. What the compliant wrist drives to zero (paper 003 Fig. 6b, 7b).
+    /// patches. What the compliant wrist drives to zero (interactive-force-control paper Fig. 6b, 7b).
     pub hand_moment: nalgebra::Vector3<f64>,
 }

@@ -13,9 +13,9 @@ mod task_set;
 #[cfg(test)]
 mod tests;
 
+pub use crate::tasks::posture::BaseReference;
 pub use cycle::Controller;
 pub use hand_force::HandForceMap;
 pub use io::{ControllerInput, ControllerOutput, Fault};
 pub use setup::{ControllerConfig, ControllerSetup, HierarchyDynamics, SetupError};
 pub use task_set::TaskKind;
-pub use crate::tasks::posture::BaseReference;

@@ -9,11 +9,11 @@ use thiserror::Error;
 
 use crate::hierarchy::{HierarchyError, InverseParams};
 use crate::model::{ModelError, RobotModel};
+use crate::param_file::yaml::{self, YamlError};
+use crate::param_file::ParamsError;
 use crate::resolver::{ResolverError, ResolverParams};
 use crate::skin::layout::{LayoutError, ResolvedLayout, SkinLayout};
-use crate::param_file::ParamsError;
 use crate::skin::params::SkinParams;
-use crate::param_file::yaml::{self, YamlError};
 use crate::supervisor::{ParamError, Policy, SupervisorParams, SupervisorParamsError};
 use crate::tasks::params::TaskParams;
 use crate::tasks::TaskError;
@@ -34,18 +34,18 @@ pub struct ControllerSetup {
     pub supervisor: PathBuf,
     /// Resolver parameters (`ResolverParams`).
     pub resolver: PathBuf,
-    /// Overrides the supervisor file's policy (e.g. `phases` for paper 003's experiments with
+    /// Overrides the supervisor file's policy (e.g. `phases` for interactive-force-control paper's experiments with
     /// the same arrangements file).
     #[serde(default)]
     pub policy: Option<Policy>,
     /// Frame of the end effector / hand: the goal, hand force, wrist, tactile guidance and
     /// position-hold tasks act on its origin.
     pub end_effector: String,
-    /// Patch ids of the hand (paper 003 eq. (9)-(10): the hand force signal and the wrist
+    /// Patch ids of the hand (interactive-force-control paper eq. (9)-(10): the hand force signal and the wrist
     /// moment). Empty: those tasks see no signal.
     #[serde(default)]
     pub hand_patches: Vec<u32>,
-    /// Patch ids whose touches guide the hand (paper 003 eq. (11), the arm patches).
+    /// Patch ids whose touches guide the hand (interactive-force-control paper eq. (11), the arm patches).
     #[serde(default)]
     pub guidance_patches: Vec<u32>,
     /// Joints held still (e.g. TOMM's base when it is switched off, or a scene that freezes it):
@@ -58,7 +58,7 @@ pub struct ControllerSetup {
     /// The damped, rank-aware inverse of the hierarchy (`docs/hierarchy.md`).
     #[serde(default)]
     pub inverse: InverseParams,
-    /// The dynamics the hierarchy (paper 003 eq. 19-25) is solved with.
+    /// The dynamics the hierarchy (interactive-force-control paper eq. 19-25) is solved with.
     #[serde(default)]
     pub hierarchy_dynamics: HierarchyDynamics,
 }
@@ -67,14 +67,14 @@ pub struct ControllerSetup {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum HierarchyDynamics {
-    /// The model's `M(q)` and `C q̇ + g`, as in paper 003 eq. (23). The resolver then executes
+    /// The model's `M(q)` and `C q̇ + g`, as in interactive-force-control paper eq. (23). The resolver then executes
     /// the torque with its own `M_a`, `C_a` (eq. 26), so the executed motion is not the one the
-    /// projection decoupled: paper 000's force levels are tuned with it.
+    /// projection decoupled: intentional-contact paper's force levels are tuned with it.
     #[default]
     Model,
     /// The resolver's virtual dynamics (`Resolver::virtual_dynamics`: `M_a`, `M_b`, bias
     /// `g + C_a q̇`): the executed acceleration is the hierarchy's, so strict priority holds in the
-    /// motion the robot makes (paper 003's acceleration levels: hand force, wrist).
+    /// motion the robot makes (interactive-force-control paper's acceleration levels: hand force, wrist).
     Admittance,
 }
 
@@ -184,7 +184,14 @@ fn read_setup(path: &Path, depth: usize) -> Result<(ControllerSetup, String), Se
     let (mut merged, _) = read_setup(&path.parent().unwrap_or(Path::new(".")).join(&base), depth + 1)?;
     // the base's file paths, relative to the base's directory, made relative to this one's
     let base_dir = base.parent().unwrap_or(Path::new(""));
-    for p in [&mut merged.urdf, &mut merged.skin_layout, &mut merged.skin_model, &mut merged.tasks, &mut merged.supervisor, &mut merged.resolver] {
+    for p in [
+        &mut merged.urdf,
+        &mut merged.skin_layout,
+        &mut merged.skin_model,
+        &mut merged.tasks,
+        &mut merged.supervisor,
+        &mut merged.resolver,
+    ] {
         *p = base_dir.join(&*p);
     }
     let serde_json::Value::Object(mut merged) = serde_json::to_value(&merged).expect("a setup serializes") else {
@@ -194,10 +201,12 @@ fn read_setup(path: &Path, depth: usize) -> Result<(ControllerSetup, String), Se
     for (key, value) in layer {
         let mut one = merged.clone();
         one.insert(key.clone(), value.clone());
-        serde_json::from_value::<ControllerSetup>(serde_json::Value::Object(one)).map_err(|e| invalid(&key, e.to_string()))?;
+        serde_json::from_value::<ControllerSetup>(serde_json::Value::Object(one))
+            .map_err(|e| invalid(&key, e.to_string()))?;
         merged.insert(key, value);
     }
-    let setup = serde_json::from_value(serde_json::Value::Object(merged)).map_err(|e| invalid("base", e.to_string()))?;
+    let setup =
+        serde_json::from_value(serde_json::Value::Object(merged)).map_err(|e| invalid("base", e.to_string()))?;
     Ok((setup, source))
 }
 

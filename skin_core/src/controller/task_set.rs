@@ -23,29 +23,29 @@ use crate::tasks::TaskError;
 /// A task name of `config/supervisor.yaml`'s `tasks` list and what it does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TaskKind {
-    /// `avoidance`: paper 000 eq. (3)-(4), force rows per cell in range.
+    /// `avoidance`: intentional-contact paper eq. (3)-(4), force rows per cell in range.
     Avoidance,
-    /// `goal`: paper 000 eq. (7)-(9), end-effector position.
+    /// `goal`: intentional-contact paper eq. (7)-(9), end-effector position.
     Goal,
-    /// `goal_orientation`: the second goal task of paper 000 Sec. V (end-effector orientation).
+    /// `goal_orientation`: the second goal task of intentional-contact paper Sec. V (end-effector orientation).
     GoalOrientation,
-    /// `contact_reaction`: paper 000 eq. (6), force rows per contact cell.
+    /// `contact_reaction`: intentional-contact paper eq. (6), force rows per contact cell.
     ContactReaction,
-    /// `hand_distance`: paper 003 eq. (9) on the hand's proximity (approach).
+    /// `hand_distance`: interactive-force-control paper eq. (9) on the hand's proximity (approach).
     HandDistance,
-    /// `hand_force`: paper 003 eq. (9) on the fused hand signal (contact).
+    /// `hand_force`: interactive-force-control paper eq. (9) on the fused hand signal (contact).
     HandForce,
-    /// `wrist`: paper 003 eq. (10).
+    /// `wrist`: interactive-force-control paper eq. (10).
     Wrist,
-    /// `tactile_guidance`: paper 003 eq. (11)-(12).
+    /// `tactile_guidance`: interactive-force-control paper eq. (11)-(12).
     TactileGuidance,
-    /// `position_hold`: paper 003 Table 1, `x_d = x_ef,init` captured at the switch.
+    /// `position_hold`: interactive-force-control paper Table 1, `x_d = x_ef,init` captured at the switch.
     PositionHold,
-    /// `base_avoidance`: paper 003 eq. (15)-(17), `τ_oca` in the posture torque.
+    /// `base_avoidance`: interactive-force-control paper eq. (15)-(17), `τ_oca` in the posture torque.
     BaseAvoidance,
-    /// `compliance`: paper 003 eq. (13)-(14), the body skin torque in the posture torque.
+    /// `compliance`: interactive-force-control paper eq. (13)-(14), the body skin torque in the posture torque.
     Compliance,
-    /// `posture`: paper 003 eq. (18), joint compliance toward `q_post`.
+    /// `posture`: interactive-force-control paper eq. (18), joint compliance toward `q_post`.
     Posture,
 }
 
@@ -173,7 +173,9 @@ impl TaskSet {
         let mut posture = Posture::new(nv, &p.posture, &q_post)
             .map_err(|error| SetupError::Task { file: config.source.clone(), error })?;
         if let ([Some(x), Some(y), Some(yaw)], Some(gains)) = (base_joints, p.posture.base) {
-            posture.set_base_gains([x, y, yaw], gains).map_err(|error| SetupError::Task { file: config.source.clone(), error })?;
+            posture
+                .set_base_gains([x, y, yaw], gains)
+                .map_err(|error| SetupError::Task { file: config.source.clone(), error })?;
         }
         let zero = Vector3::zeros();
         Ok(TaskSet {
@@ -192,7 +194,7 @@ impl TaskSet {
         })
     }
 
-    /// Sets `f_c,d` of the hand force task (paper 003 eq. 9), in signal units.
+    /// Sets `f_c,d` of the hand force task (interactive-force-control paper eq. 9), in signal units.
     pub(crate) fn set_hand_force_reference(&mut self, signal: f64) {
         self.hand.params.force_signal_desired = signal;
     }

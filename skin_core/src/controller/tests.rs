@@ -42,11 +42,16 @@ fn shipped_setups_load_and_run_a_quiet_cycle() {
         let nv = c.config().model.nv();
         let q = if c.config().setup.posture.is_empty() { vec![0.0; nv] } else { c.config().setup.posture.clone() };
         let cells = vec![CellReading::default(); c.config().layout.num_cells()];
-        let out = c.update(&ControllerInput { t_s: 0.0, dt_s: 0.008, q: &q, qd: &vec![0.0; nv], cells: &cells, scan: &[] });
+        let out =
+            c.update(&ControllerInput { t_s: 0.0, dt_s: 0.008, q: &q, qd: &vec![0.0; nv], cells: &cells, scan: &[] });
         assert_eq!(out.fault, None, "{robot}");
         assert_eq!(out.mode, Mode::Avoidance, "{robot}");
         assert!(out.signals.goal_error_m.is_nan(), "no goal: NaN goal error");
-        assert!(out.commands.joint_velocities.iter().all(|v| v.abs() < 1e-6), "{robot}: at rest without tasks: {:?}", out.commands);
+        assert!(
+            out.commands.joint_velocities.iter().all(|v| v.abs() < 1e-6),
+            "{robot}: at rest without tasks: {:?}",
+            out.commands
+        );
     }
 }
 
@@ -86,9 +91,18 @@ fn bad_inputs_make_safe_stop_steps() {
     assert!(moving > 0.05, "moving toward the goal");
     qd[3] = f64::NAN;
     let inputs = [
-        (Fault::NonFinite { input: "qd", index: 3 }, ControllerInput { t_s: 1.0, dt_s: dt, q: &q, qd: &qd, cells: &cells, scan: &[] }),
-        (Fault::Length { input: "q", expected: 7, got: 6 }, ControllerInput { t_s: 1.0, dt_s: dt, q: &q[..6], qd: &q, cells: &cells, scan: &[] }),
-        (Fault::Length { input: "cells", expected: cells.len(), got: 3 }, ControllerInput { t_s: 1.0, dt_s: dt, q: &q, qd: &q, cells: &cells[..3], scan: &[] }),
+        (
+            Fault::NonFinite { input: "qd", index: 3 },
+            ControllerInput { t_s: 1.0, dt_s: dt, q: &q, qd: &qd, cells: &cells, scan: &[] },
+        ),
+        (
+            Fault::Length { input: "q", expected: 7, got: 6 },
+            ControllerInput { t_s: 1.0, dt_s: dt, q: &q[..6], qd: &q, cells: &cells, scan: &[] },
+        ),
+        (
+            Fault::Length { input: "cells", expected: cells.len(), got: 3 },
+            ControllerInput { t_s: 1.0, dt_s: dt, q: &q, qd: &q, cells: &cells[..3], scan: &[] },
+        ),
         (Fault::BadTimeStep, ControllerInput { t_s: 1.0, dt_s: 0.0, q: &q, qd: &q, cells: &cells, scan: &[] }),
     ];
     for (fault, input) in &inputs {
@@ -113,7 +127,8 @@ fn setup_errors_name_file_and_key() {
     assert!(e.contains("posture") && e.contains("5 values"), "{e}");
     let e = setup_error("planar7", "damping: 1.0e-3", "damping: -1.0");
     assert!(e.contains("inverse.") && e.contains("damping"), "{e}");
-    let e = setup_error("tomm", "hand_patches: [12]", "hand_patches: [12]\nlocked_joints: [base_x_joint, base_z_joint]");
+    let e =
+        setup_error("tomm", "hand_patches: [12]", "hand_patches: [12]\nlocked_joints: [base_x_joint, base_z_joint]");
     assert!(e.contains("locked_joints[1]") && e.contains("base_z_joint"), "{e}");
     let e = setup_error("tomm", "end_effector:", "end_efector:");
     assert!(e.contains("end_efector"), "unknown keys are errors: {e}");
@@ -134,11 +149,28 @@ fn a_derived_setup_is_its_base_with_its_keys_replaced() {
     // what the derived file sets differs; everything else comes through two bases (the file
     // paths rebased to the derived file's directory)
     assert_ne!(table.posture, phases.posture);
-    let rebased = ControllerSetup { urdf: table.urdf.clone(), skin_layout: table.skin_layout.clone(), skin_model: table.skin_model.clone(), tasks: table.tasks.clone(), supervisor: table.supervisor.clone(), resolver: table.resolver.clone(), ..phases.clone() };
+    let rebased = ControllerSetup {
+        urdf: table.urdf.clone(),
+        skin_layout: table.skin_layout.clone(),
+        skin_model: table.skin_model.clone(),
+        tasks: table.tasks.clone(),
+        supervisor: table.supervisor.clone(),
+        resolver: table.resolver.clone(),
+        ..phases.clone()
+    };
     assert_eq!(ControllerSetup { posture: phases.posture.clone(), ..table.clone() }, rebased);
     assert_eq!(phases.policy, Some(crate::supervisor::Policy::Phases));
     let resolver = tomm.resolver.clone();
-    assert_eq!(ControllerSetup { posture: tomm.posture.clone(), policy: None, hierarchy_dynamics: tomm.hierarchy_dynamics, resolver, ..phases }, tomm);
+    assert_eq!(
+        ControllerSetup {
+            posture: tomm.posture.clone(),
+            policy: None,
+            hierarchy_dynamics: tomm.hierarchy_dynamics,
+            resolver,
+            ..phases
+        },
+        tomm
+    );
     Controller::from_setup_file(&derived, 0.0).expect("the bases' relative paths resolve");
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -215,13 +247,16 @@ fn hand_moment_is_the_palm_patch_moment_in_the_hand_frame() {
     let mut cells = vec![CellReading::default(); layout.num_cells()];
     // one off-centre cell of the palm: a moment about the patch origin
     cells[patch.cells.start] = CellReading::uniform(0.5, 1.0);
-    let out = c.update(&ControllerInput { t_s: 0.0, dt_s: 0.008, q: &q, qd: &vec![0.0; nv], cells: &cells, scan: &[] }).clone();
+    let out = c
+        .update(&ControllerInput { t_s: 0.0, dt_s: 0.008, q: &q, qd: &vec![0.0; nv], cells: &cells, scan: &[] })
+        .clone();
     let patch_moment = c.patch_wrenches()[palm].moment;
     assert!(patch_moment.norm() > 1e-4, "an off-centre cell gives a moment: {patch_moment}");
     // one patch: the same moment, rotated from the patch into the hand frame
     assert!((out.hand_moment.norm() - patch_moment.norm()).abs() < 1e-12, "{} vs {patch_moment}", out.hand_moment);
     let cells = vec![CellReading::default(); c.config().layout.num_cells()];
-    let out = c.update(&ControllerInput { t_s: 0.008, dt_s: 0.008, q: &q, qd: &vec![0.0; nv], cells: &cells, scan: &[] });
+    let out =
+        c.update(&ControllerInput { t_s: 0.008, dt_s: 0.008, q: &q, qd: &vec![0.0; nv], cells: &cells, scan: &[] });
     assert_eq!(out.hand_moment, Vector3::zeros(), "no touch, no moment");
 }
 

@@ -147,7 +147,13 @@ fn mul_vec2_padded_kernel(a1: &[f64], a2: &[f64], x: &[f64], y1: &mut [f64], y2:
 /// [`mul_vec`]), but `S · PASS · BLOCK / 4` independent sums share a pass, so the adds' latency
 /// (a dependent chain of q adds per sum) overlaps instead of adding up.
 #[inline(always)]
-fn mul_vec_streams<const S: usize, const ADD: bool>(a: [&[f64]; S], x: [&[f64]; S], mut y: [&mut [f64]; S], ld: usize, q: usize) {
+fn mul_vec_streams<const S: usize, const ADD: bool>(
+    a: [&[f64]; S],
+    x: [&[f64]; S],
+    mut y: [&mut [f64]; S],
+    ld: usize,
+    q: usize,
+) {
     const PASS: usize = 2;
     with_const_ld!(ld, {
         let blocks = ld / BLOCK;
@@ -164,7 +170,14 @@ fn mul_vec_streams<const S: usize, const ADD: bool>(a: [&[f64]; S], x: [&[f64]; 
 
 /// Rows `b0 · BLOCK ..< (b0 + G) · BLOCK` of [`mul_vec_streams`].
 #[inline(always)]
-fn mul_vec_pass<const S: usize, const G: usize, const ADD: bool>(a: &[&[f64]; S], x: &[&[f64]; S], y: &mut [&mut [f64]; S], ld: usize, q: usize, b0: usize) {
+fn mul_vec_pass<const S: usize, const G: usize, const ADD: bool>(
+    a: &[&[f64]; S],
+    x: &[&[f64]; S],
+    y: &mut [&mut [f64]; S],
+    ld: usize,
+    q: usize,
+    b0: usize,
+) {
     let mut acc = [[[0.0; BLOCK]; G]; S];
     if ADD {
         for (accs, ys) in acc.iter_mut().zip(y.iter()) {
@@ -173,7 +186,8 @@ fn mul_vec_pass<const S: usize, const G: usize, const ADD: bool>(a: &[&[f64]; S]
             }
         }
     }
-    let (a, x): ([&[f64]; S], [&[f64]; S]) = (std::array::from_fn(|s| &a[s][..ld * q]), std::array::from_fn(|s| &x[s][..q]));
+    let (a, x): ([&[f64]; S], [&[f64]; S]) =
+        (std::array::from_fn(|s| &a[s][..ld * q]), std::array::from_fn(|s| &x[s][..q]));
     for k in 0..q {
         for s in 0..S {
             let xk = x[s][k];
@@ -236,7 +250,16 @@ fn sub_outer_mul_vec_padded_kernel(a: &mut [f64], u: &[f64], v: &[f64], x: &[f64
 /// Rows `b0 · BLOCK ..< (b0 + G) · BLOCK` of [`sub_outer_mul_vec_padded`].
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn sub_outer_mul_vec_pass<const G: usize>(a: &mut [f64], u: &[f64], v: &[f64], x: &[f64], y: &mut [f64], ld: usize, q: usize, b0: usize) {
+fn sub_outer_mul_vec_pass<const G: usize>(
+    a: &mut [f64],
+    u: &[f64],
+    v: &[f64],
+    x: &[f64],
+    y: &mut [f64],
+    ld: usize,
+    q: usize,
+    b0: usize,
+) {
     let mut acc = [[0.0; BLOCK]; G];
     let u = &u[b0 * BLOCK..(b0 + G) * BLOCK];
     for ((col, &vk), &xk) in a[..ld * q].chunks_exact_mut(ld).zip(&v[..q]).zip(&x[..q]) {
@@ -333,7 +356,10 @@ mod tests {
             let plain = sample(n * q, n as u64);
             let mut a = vec![0.0; ld * q];
             pad(&plain, &mut a, n, ld, q);
-            let (x, y0) = (sample(q, 7), sample(ld, 8).iter().enumerate().map(|(i, v)| if i < n { *v } else { 0.0 }).collect::<Vec<_>>());
+            let (x, y0) = (
+                sample(q, 7),
+                sample(ld, 8).iter().enumerate().map(|(i, v)| if i < n { *v } else { 0.0 }).collect::<Vec<_>>(),
+            );
 
             let mut want = vec![0.0; n];
             mul_vec(&plain, &x, &mut want, n, q);

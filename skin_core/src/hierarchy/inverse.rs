@@ -3,7 +3,7 @@
 //! - `M⁻¹` of the SPD joint-space mass matrix: Cholesky `M = L Lᵀ`, then `M⁻¹ = L⁻ᵀ L⁻¹`
 //!   (our own in-place code: nalgebra's `Cholesky` takes and returns owned matrices, which
 //!   allocates for dynamic sizes). About n³ flops; n = 15 for TOMM.
-//! - the damped, rank-aware inverse `Λ̄ = (J̄ M⁻¹ J̄ᵀ)⁻¹` of paper 003 eq. (23): the matrix is
+//! - the damped, rank-aware inverse `Λ̄ = (J̄ M⁻¹ J̄ᵀ)⁻¹` of interactive-force-control paper eq. (23): the matrix is
 //!   symmetric positive semidefinite, so it is diagonalized in place (Householder tridiagonal
 //!   reduction + implicit QL; nalgebra's `SymmetricEigen` does the same but allocates) and every
 //!   eigenvalue is inverted by the filter [`InverseParams::filter`].
@@ -11,7 +11,7 @@
 use super::dense::sub_outer_padded_kernel;
 use super::HierarchyError;
 
-/// Parameters of the damped, rank-aware inverse of `A = J̄ M⁻¹ J̄ᵀ` (paper 003 eq. 23, 25).
+/// Parameters of the damped, rank-aware inverse of `A = J̄ M⁻¹ J̄ᵀ` (interactive-force-control paper eq. 23, 25).
 ///
 /// Eigenvalues `e` of `A` are "task-space inverse masses" (1/kg for translational rows,
 /// 1/(kg m²) for rotational rows). With `e_max` the largest eigenvalue of the level:
@@ -60,8 +60,18 @@ impl InverseParams {
                 Err(HierarchyError::InvalidParameter { name, value, reason })
             }
         };
-        check("rank_threshold_rel", self.rank_threshold_rel, (0.0..1.0).contains(&self.rank_threshold_rel), "must be in [0, 1)")?;
-        check("rank_threshold_abs", self.rank_threshold_abs, self.rank_threshold_abs >= 0.0, "must be finite and >= 0")?;
+        check(
+            "rank_threshold_rel",
+            self.rank_threshold_rel,
+            (0.0..1.0).contains(&self.rank_threshold_rel),
+            "must be in [0, 1)",
+        )?;
+        check(
+            "rank_threshold_abs",
+            self.rank_threshold_abs,
+            self.rank_threshold_abs >= 0.0,
+            "must be finite and >= 0",
+        )?;
         check("damping", self.damping, self.damping >= 0.0, "must be finite and >= 0")
     }
 
@@ -477,7 +487,11 @@ pub(crate) fn damped_inverse(
 
 /// Bit i set: row i of the symmetric `a` (m × m, m ≤ 64) is exactly zero.
 fn zero_rows(a: &[f64], m: usize) -> u64 {
-    a[..m * m].chunks_exact(m).enumerate().filter(|(_, col)| col.iter().all(|&x| x == 0.0)).fold(0, |z, (i, _)| z | 1 << i)
+    a[..m * m]
+        .chunks_exact(m)
+        .enumerate()
+        .filter(|(_, col)| col.iter().all(|&x| x == 0.0))
+        .fold(0, |z, (i, _)| z | 1 << i)
 }
 
 /// Moves the rows and columns of `a` (m × m) that are not in `zero` to the front, as a
@@ -608,7 +622,10 @@ mod tests {
     fn cholesky_rejects_indefinite() {
         let m = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
         let mut l = vec![0.0; 4];
-        assert!(matches!(cholesky(m.as_slice(), &mut l, 2, 2), Err(HierarchyError::NotPositiveDefinite { index: 1, .. })));
+        assert!(matches!(
+            cholesky(m.as_slice(), &mut l, 2, 2),
+            Err(HierarchyError::NotPositiveDefinite { index: 1, .. })
+        ));
     }
 
     #[test]
@@ -655,7 +672,8 @@ mod tests {
         let p = InverseParams::default();
         for m in [1, 3, 6] {
             let a0 = random_spd(m, 40 + m as u64);
-            let (mut a, mut v, mut w, mut fast) = (a0.as_slice().to_vec(), vec![0.0; m * m], vec![0.0; m * m], vec![0.0; m * m]);
+            let (mut a, mut v, mut w, mut fast) =
+                (a0.as_slice().to_vec(), vec![0.0; m * m], vec![0.0; m * m], vec![0.0; m * m]);
             damped_inverse(&mut a, &mut v, &mut w, &mut fast, m, &p);
             // the eigen path on the same matrix
             let mut a = a0.as_slice().to_vec();
@@ -671,7 +689,9 @@ mod tests {
     #[test]
     fn eigen_2x2_handles_the_edge_cases() {
         // diagonal, rank one, equal diagonal, a coupling far below the diagonal's scale, and one far above
-        for [a00, a10, a11] in [[2.0, 0.0, 3.0], [1.0, 2.0, 4.0], [5.0, 1e-3, 5.0], [1.0, 1e-200, 2.0], [1e-9, 1e9, 0.0]] {
+        for [a00, a10, a11] in
+            [[2.0, 0.0, 3.0], [1.0, 2.0, 4.0], [5.0, 1e-3, 5.0], [1.0, 1e-200, 2.0], [1e-9, 1e9, 0.0]]
+        {
             let a0 = DMatrix::from_column_slice(2, 2, &[a00, a10, a10, a11]);
             let (mut a, mut v) = (a0.as_slice().to_vec(), vec![0.0; 4]);
             symmetric_eigen(&mut a, &mut v, 2);
@@ -689,13 +709,18 @@ mod tests {
         let inner = random_spd(3, 9);
         // the 3 × 3 matrix spread over rows/columns 0, 2, 4 of a 5 × 5 one
         let at = [0, 2, 4];
-        let a0 = DMatrix::from_fn(5, 5, |r, c| match (at.iter().position(|&i| i == r), at.iter().position(|&i| i == c)) {
-            (Some(i), Some(j)) => inner[(i, j)],
-            _ => 0.0,
-        });
+        let a0 =
+            DMatrix::from_fn(5, 5, |r, c| match (at.iter().position(|&i| i == r), at.iter().position(|&i| i == c)) {
+                (Some(i), Some(j)) => inner[(i, j)],
+                _ => 0.0,
+            });
         let run = |split: bool| {
             let (mut a, mut v, mut w, mut out) = (a0.as_slice().to_vec(), vec![0.0; 25], vec![0.0; 25], vec![7.0; 25]);
-            let info = if split { damped_inverse(&mut a, &mut v, &mut w, &mut out, 5, &p) } else { damped_inverse_full(&mut a, &mut v, &mut w, &mut out, 5, &p) };
+            let info = if split {
+                damped_inverse(&mut a, &mut v, &mut w, &mut out, 5, &p)
+            } else {
+                damped_inverse_full(&mut a, &mut v, &mut w, &mut out, 5, &p)
+            };
             (info, DMatrix::from_column_slice(5, 5, &out))
         };
         let ((info, split), (whole_info, whole)) = (run(true), run(false));

@@ -1,5 +1,5 @@
-//! Multi-priority torque control: the task hierarchy of paper 003 Sec. 3.3 (eq. 19-25, after
-//! Sadeghian et al.), with the task-space force levels of paper 000 (`τ = J_kᵀ F_k`) composed in
+//! Multi-priority torque control: the task hierarchy of interactive-force-control paper Sec. 3.3 (eq. 19-25, after
+//! Sadeghian et al.), with the task-space force levels of intentional-contact paper (`τ = J_kᵀ F_k`) composed in
 //! the same augmented null-space projection.
 //!
 //! - [`TaskLevel`]: one priority level, a Jacobian block and a [`Reference`] (acceleration or

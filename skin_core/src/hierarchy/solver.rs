@@ -1,4 +1,4 @@
-//! The multi-priority torque solver of paper 003 eq. (19)-(25), with paper 000's force levels in
+//! The multi-priority torque solver of interactive-force-control paper eq. (19)-(25), with intentional-contact paper's force levels in
 //! the same pass.
 
 use nalgebra::{DMatrix, DVector};
@@ -6,10 +6,13 @@ use nalgebra::{DMatrix, DVector};
 use crate::model::{bias_forces, crba, ModelData, RobotModel};
 
 use super::dense::{
-    add_mul_vec, add_mul_vec_padded, axpy, dot, mul, mul_padded, mul_tn, mul_tr_vec, mul_vec, mul_vec2_padded, mul_vec_padded, sub_outer_mul_vec_padded, norm, pad, padded_len, set_identity_padded,
-    sub_mul_nt, sub_mul_nt_padded, sub_outer_padded, unpad,
+    add_mul_vec, add_mul_vec_padded, axpy, dot, mul, mul_padded, mul_tn, mul_tr_vec, mul_vec, mul_vec2_padded,
+    mul_vec_padded, norm, pad, padded_len, set_identity_padded, sub_mul_nt, sub_mul_nt_padded,
+    sub_outer_mul_vec_padded, sub_outer_padded, unpad,
 };
-use super::inverse::{cholesky, damped_inverse, lower_inverse_padded, spd_inverse_padded, symmetric_eigen, InverseParams};
+use super::inverse::{
+    cholesky, damped_inverse, lower_inverse_padded, spd_inverse_padded, symmetric_eigen, InverseParams,
+};
 use super::{HierarchyError, ReferenceKind, TaskLevel};
 
 /// What one level did in the last solve.
@@ -46,9 +49,9 @@ impl LevelDiagnostics {
 /// function (mass matrix, ordered levels, posture torque, bias) → torque.
 ///
 /// ```text
-/// τ* = Σ_k τ̄_k + N_L τ_c* + (C q̇ + g)                              paper 003 eq. (19)
+/// τ* = Σ_k τ̄_k + N_L τ_c* + (C q̇ + g)                              interactive-force-control paper eq. (19)
 /// τ̄_k = J̄_kᵀ Λ̄_k (ẍ*_k − J̇_k q̇ − a_k)        acceleration level, eq. (20)
-/// τ̄_k = J̄_kᵀ F_k = N_{k−1} J_kᵀ F_k             force level (paper 000, augmented projection)
+/// τ̄_k = J̄_kᵀ F_k = N_{k−1} J_kᵀ F_k             force level (intentional-contact paper, augmented projection)
 /// a_k = J_k M⁻¹ Σ_{i<k} τ̄_i                                          eq. (21)
 /// J̄_k = J_k N_{k−1}ᵀ                                                 eq. (22)
 /// Λ̄_k = (J̄_k M⁻¹ J̄_kᵀ)⁻¹   damped, rank-aware (InverseParams)        eq. (23)
@@ -192,7 +195,7 @@ impl HierarchySolver {
         &self.qdd
     }
 
-    /// Computes paper 003 eq. (19)-(25) into `tau_out`.
+    /// Computes interactive-force-control paper eq. (19)-(25) into `tau_out`.
     ///
     /// - `mass_matrix`: `M(q)` (nv × nv, symmetric positive definite; the lower triangle is read),
     ///   e.g. from `model::crba`. Factorized here every call.
@@ -201,7 +204,7 @@ impl HierarchySolver {
     ///   is just an order). Empty levels are skipped.
     /// - `posture`: `τ_c*` of eq. (18), projected into the null space of all levels (`None`: 0).
     /// - `bias`: `C q̇ + g` (e.g. `model::bias_forces`) added at the end; `None` leaves it out (the
-    ///   admittance resolver of paper 003 eq. (26) adds g itself).
+    ///   admittance resolver of interactive-force-control paper eq. (26) adds g itself).
     ///
     /// Inputs are checked first (sizes, finiteness); on error `tau_out` is untouched.
     pub fn solve<'a, I>(
@@ -269,7 +272,14 @@ impl HierarchySolver {
                     self.a[r * m + c] = s;
                 }
             }
-            let info = damped_inverse(&mut self.a[..mm], &mut self.v[..mm], &mut self.w[..mm], &mut self.lam[..mm], m, &self.params);
+            let info = damped_inverse(
+                &mut self.a[..mm],
+                &mut self.v[..mm],
+                &mut self.w[..mm],
+                &mut self.lam[..mm],
+                m,
+                &self.params,
+            );
             diag.rows = m;
             diag.rank = info.rank;
             diag.damped = info.damped;
@@ -349,7 +359,13 @@ impl HierarchySolver {
     /// ```
     ///
     /// Cost `m n² + O(n³)` instead of `O(m³)`: 50 active cells on one level stay cheap.
-    fn wide_level(&mut self, k: usize, level: &TaskLevel, diag: &mut LevelDiagnostics, first: &mut bool) -> Result<(), HierarchyError> {
+    fn wide_level(
+        &mut self,
+        k: usize,
+        level: &TaskLevel,
+        diag: &mut LevelDiagnostics,
+        first: &mut bool,
+    ) -> Result<(), HierarchyError> {
         let (n, m, ld) = (self.nv, level.rows(), padded_len(self.nv));
         let (nm, nn) = (n * m, n * n);
         if !self.lower_ready {
@@ -445,7 +461,13 @@ impl HierarchySolver {
     /// same space; the damping band `f` of [`InverseParams`] fades dependent rows); a row with
     /// `a_i = 0` leaves `N` as if it were absent, and `N` is continuous in every `a_i` (in the
     /// M-metric each factor has eigenvalues `1` and `1 − a_i e_i f(e_i) ∈ [0, 1]`).
-    fn activated_level(&mut self, k: usize, level: &TaskLevel, diag: &mut LevelDiagnostics, first: &mut bool) -> Result<(), HierarchyError> {
+    fn activated_level(
+        &mut self,
+        k: usize,
+        level: &TaskLevel,
+        diag: &mut LevelDiagnostics,
+        first: &mut bool,
+    ) -> Result<(), HierarchyError> {
         let (n, m) = (self.nv, level.rows());
         if *first {
             mul_vec(level.jt_slice(), level.target(), &mut self.tau_bar, n, m);
@@ -574,7 +596,13 @@ impl HierarchySolver {
         tau_out: &DVector<f64>,
     ) -> Result<(), HierarchyError> {
         let n = self.nv;
-        let dim = |what, got: usize| if got == n { Ok(()) } else { Err(HierarchyError::Dimension { what, expected: n, got }) };
+        let dim = |what, got: usize| {
+            if got == n {
+                Ok(())
+            } else {
+                Err(HierarchyError::Dimension { what, expected: n, got })
+            }
+        };
         dim("mass matrix rows", mass_matrix.nrows())?;
         dim("mass matrix columns", mass_matrix.ncols())?;
         dim("torque output", tau_out.len())?;
@@ -602,7 +630,12 @@ impl HierarchySolver {
             return Err(HierarchyError::Capacity { what: "levels".to_string(), got: k + 1, capacity: self.max_levels });
         }
         if level.nv() != self.nv {
-            return Err(HierarchyError::LevelColumns { level: k, name: level.name().to_string(), expected: self.nv, got: level.nv() });
+            return Err(HierarchyError::LevelColumns {
+                level: k,
+                name: level.name().to_string(),
+                expected: self.nv,
+                got: level.nv(),
+            });
         }
         if level.rows() > self.max_rows {
             return Err(HierarchyError::Capacity {
@@ -611,7 +644,13 @@ impl HierarchySolver {
                 capacity: self.max_rows,
             });
         }
-        let bad = |what, index: usize, value: f64| HierarchyError::NonFiniteLevel { level: k, name: level.name().to_string(), what, index, value };
+        let bad = |what, index: usize, value: f64| HierarchyError::NonFiniteLevel {
+            level: k,
+            name: level.name().to_string(),
+            what,
+            index,
+            value,
+        };
         if let Some(i) = first_non_finite(level.jt_slice()) {
             // storage is Jᵀ column-major, so i = row · nv + column of J
             return Err(bad("jacobian", i, level.jt_slice()[i]));

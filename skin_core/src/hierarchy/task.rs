@@ -4,12 +4,12 @@ use nalgebra::{DMatrixSlice, Dim, Matrix, Storage};
 
 use super::HierarchyError;
 
-/// What a level asks for: a task-space acceleration (paper 003 eq. 9, 10, 12) or a task-space
-/// force (paper 000 eq. 3-6). Borrowed: [`TaskLevel::push`] copies it into the level's storage.
+/// What a level asks for: a task-space acceleration (interactive-force-control paper eq. 9, 10, 12) or a task-space
+/// force (intentional-contact paper eq. 3-6). Borrowed: [`TaskLevel::push`] copies it into the level's storage.
 #[derive(Clone, Copy, Debug)]
 pub enum Reference<'a> {
     /// Reference acceleration `ẍ*` and the drift `J̇ q̇` of the same rows; the level's torque
-    /// realizes `ẍ* − J̇ q̇ − a_k` (paper 003 eq. 20).
+    /// realizes `ẍ* − J̇ q̇ − a_k` (interactive-force-control paper eq. 20).
     Acceleration {
         /// Reference task acceleration `ẍ*_k` (one entry per row).
         xdd_star: &'a [f64],
@@ -26,9 +26,9 @@ pub enum Reference<'a> {
 /// Kind of a level's reference.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ReferenceKind {
-    /// Task-space acceleration (paper 003).
+    /// Task-space acceleration (interactive-force-control paper).
     Acceleration,
-    /// Task-space force (paper 000).
+    /// Task-space force (intentional-contact paper).
     Force,
 }
 
@@ -251,7 +251,9 @@ impl TaskLevel {
     #[inline(always)]
     fn begin_rows(&mut self, k: usize, reference: &Reference<'_>) -> Result<usize, HierarchyError> {
         let (kind, lens) = match reference {
-            Reference::Acceleration { xdd_star, jdot_qdot } => (ReferenceKind::Acceleration, [xdd_star.len(), jdot_qdot.len()]),
+            Reference::Acceleration { xdd_star, jdot_qdot } => {
+                (ReferenceKind::Acceleration, [xdd_star.len(), jdot_qdot.len()])
+            }
             Reference::Force { f } => (ReferenceKind::Force, [f.len(), f.len()]),
         };
         if lens.iter().any(|&l| l != k) {

@@ -15,7 +15,11 @@ use super::{ModelData, ModelError, RobotModel};
 pub fn crba(model: &RobotModel, data: &mut ModelData, m_out: &mut DMatrix<f64>) -> Result<(), ModelError> {
     let n = model.nv();
     if m_out.nrows() != n || m_out.ncols() != n {
-        return Err(ModelError::Dimension { what: "mass matrix rows/columns", expected: n, got: m_out.nrows().max(m_out.ncols()) });
+        return Err(ModelError::Dimension {
+            what: "mass matrix rows/columns",
+            expected: n,
+            got: m_out.nrows().max(m_out.ncols()),
+        });
     }
     data.composite.copy_from_slice(&data.inertia_w);
     // children have larger indices than their parents (depth-first numbering)

@@ -41,7 +41,8 @@ pub(crate) fn project_principal_moments(l: &Vector3<f64>) -> Vector3<f64> {
     }
     let mut best = Vector3::zeros(); // all three active: the apex
     for set in 1..7u8 {
-        let active: Vec<Vector3<f64>> = (0..3).filter(|k| set & (1 << k) != 0).map(|k| Vector3::from(NORMALS[k])).collect();
+        let active: Vec<Vector3<f64>> =
+            (0..3).filter(|k| set & (1 << k) != 0).map(|k| Vector3::from(NORMALS[k])).collect();
         // x = l − Nᵀ (N Nᵀ)⁻¹ N l for the active normals N
         let k = active.len();
         let gram = nalgebra::DMatrix::from_fn(k, k, |i, j| active[i].dot(&active[j]));
@@ -62,7 +63,9 @@ pub(crate) fn check(link: &str, mass: f64, i: &Matrix3<f64>, tol: f64) -> Verdic
             Verdict::Valid
         } else {
             Verdict::Kept {
-                warning: format!("link \"{link}\": zero mass with a non-zero inertia, kept as given (a rotor-like body)"),
+                warning: format!(
+                    "link \"{link}\": zero mass with a non-zero inertia, kept as given (a rotor-like body)"
+                ),
             }
         };
     }
@@ -108,7 +111,10 @@ pub(crate) fn check(link: &str, mass: f64, i: &Matrix3<f64>, tol: f64) -> Verdic
     );
     if l.min() < 0.0 {
         let clipped = l.map(|x| x.max(0.0));
-        return Verdict::Changed { inertia: rebuild(&clipped), warning: format!("{warning}; negative moments clipped to zero") };
+        return Verdict::Changed {
+            inertia: rebuild(&clipped),
+            warning: format!("{warning}; negative moments clipped to zero"),
+        };
     }
     Verdict::Kept { warning }
 }

@@ -195,7 +195,7 @@ pub fn point_jacobian(
 
 /// The row `dᵀ J_v` of the point `point_in_frame` of frame `frame`: the linear rows of
 /// [`point_jacobian`] along the world direction `d`, into `out` (length nv), without forming the
-/// 6 × nv Jacobian (one skin cell's force row, paper 000 eq. 4 and 6).
+/// 6 × nv Jacobian (one skin cell's force row, intentional-contact paper eq. 4 and 6).
 ///
 /// Entry j is the power of the unit force `d` at the point through joint j's motion subspace,
 /// `s_jᵀ [r × d; d]` with `r` the point about the reference point (the force as a spatial
@@ -228,7 +228,12 @@ pub fn point_jacobian_along(
 /// Linear velocity (world axes) of the point `point_in_frame` of frame `frame`, `J_v q̇` without
 /// the Jacobian: `v_P = v_O + ω × r` from the frame's body velocity of the last
 /// [`update_kinematics`] (zero for a frame attached to the world).
-pub fn point_velocity(model: &RobotModel, data: &ModelData, frame: usize, point_in_frame: &Vector3<f64>) -> Result<Vector3<f64>, ModelError> {
+pub fn point_velocity(
+    model: &RobotModel,
+    data: &ModelData,
+    frame: usize,
+    point_in_frame: &Vector3<f64>,
+) -> Result<Vector3<f64>, ModelError> {
     check_point(model, frame, point_in_frame)?;
     let Some(b) = model.frames[frame].body else {
         return Ok(Vector3::zeros());

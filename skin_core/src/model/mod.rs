@@ -33,7 +33,9 @@ mod tests;
 
 pub use crba::crba;
 pub use error::ModelError;
-pub use kinematics::{frame_pose, point_jacobian, point_jacobian_along, point_jacobian_dot_qdot, point_velocity, update_kinematics};
+pub use kinematics::{
+    frame_pose, point_jacobian, point_jacobian_along, point_jacobian_dot_qdot, point_velocity, update_kinematics,
+};
 pub use rnea::{bias_forces, gravity, rnea};
 
 use nalgebra::{Isometry3, Matrix3, Vector3};

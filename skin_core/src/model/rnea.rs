@@ -57,7 +57,12 @@ fn backward_pass(model: &RobotModel, data: &mut ModelData, tau: &mut DVector<f64
 /// RNEA (RBDA Table 5.1) in world-aligned coordinates about one reference point, reusing the
 /// velocities and velocity-product terms of `update_kinematics`. `qdd` is checked for length and
 /// NaN/∞ (the error names the joint); `tau_out` must have length nv. Does not allocate.
-pub fn rnea(model: &RobotModel, data: &mut ModelData, qdd: &[f64], tau_out: &mut DVector<f64>) -> Result<(), ModelError> {
+pub fn rnea(
+    model: &RobotModel,
+    data: &mut ModelData,
+    qdd: &[f64],
+    tau_out: &mut DVector<f64>,
+) -> Result<(), ModelError> {
     check_vector(model, "qdd", qdd)?;
     check_out(model, tau_out)?;
     rnea_impl(model, data, Some(qdd), tau_out);

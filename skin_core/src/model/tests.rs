@@ -76,10 +76,7 @@ fn probe_frames(model: &RobotModel) -> Vec<(usize, Vector3<f64>)> {
 fn tomm_structure() {
     let m = tomm();
     assert_eq!(m.nv(), 15);
-    assert_eq!(
-        &m.joint_names()[..4],
-        &["base_x_joint", "base_y_joint", "base_yaw_joint", "left_shoulder_pan_joint"]
-    );
+    assert_eq!(&m.joint_names()[..4], &["base_x_joint", "base_y_joint", "base_yaw_joint", "left_shoulder_pan_joint"]);
     assert_eq!(m.joint_names()[9], "right_shoulder_pan_joint");
     assert_eq!(m.joint_kind(0), JointKind::Prismatic);
     assert_eq!(m.joint_kind(2), JointKind::Revolute);
@@ -238,7 +235,11 @@ fn point_velocity_is_the_jacobian_times_qd() {
         for (f, p) in probe_frames(&model) {
             let expected = jac(&model, &d, f, &p).fixed_rows::<3>(0) * DVector::from_column_slice(&qd);
             let v = point_velocity(&model, &d, f, &p).unwrap();
-            assert!((v - expected).norm() <= 1e-12 * expected.norm().max(1.0), "{} frame {f}: {v} vs {expected}", model.name());
+            assert!(
+                (v - expected).norm() <= 1e-12 * expected.norm().max(1.0),
+                "{} frame {f}: {v} vs {expected}",
+                model.name()
+            );
         }
     }
 }
@@ -257,7 +258,11 @@ fn point_jacobian_along_is_the_linear_rows_along_the_direction() {
                 for (k, x) in row.iter().enumerate() {
                     let expected: f64 = dir.iter().zip(j.column(k).iter()).map(|(d, j)| d * j).sum();
                     let scale = j.column(k).norm().max(1.0);
-                    assert!((x - expected).abs() <= 1e-14 * scale, "{} frame {f} joint {k}: {x} vs {expected}", model.name());
+                    assert!(
+                        (x - expected).abs() <= 1e-14 * scale,
+                        "{} frame {f} joint {k}: {x} vs {expected}",
+                        model.name()
+                    );
                 }
             }
         }

@@ -9,7 +9,10 @@ use nalgebra::{DMatrix, Isometry3, Matrix3, Vector3};
 use super::inertia_check::{self, Verdict};
 use super::spatial::SpatialInertia;
 use super::urdf_xml::{self, Geometry, JointType, Urdf};
-use super::{Body, Collision, Frame, JointKind, JointLimits, MimicMode, ModelError, RobotModel, Shape, UrdfOptions, STANDARD_GRAVITY};
+use super::{
+    Body, Collision, Frame, JointKind, JointLimits, MimicMode, ModelError, RobotModel, Shape, UrdfOptions,
+    STANDARD_GRAVITY,
+};
 
 /// Repair tolerance of link inertias, relative to the largest link inertia of the URDF
 /// (Frobenius norm): a repair changes M by at most this fraction of the robot's inertia scale.
@@ -43,7 +46,12 @@ fn joint_el(j: &urdf_xml::Joint) -> String {
 /// within `tol` (see [`inertia_check`]). `None` for a link without mass. A link fixed to the
 /// world (`moves` false) does not enter the dynamics of this fixed-root model: what would refuse
 /// a moving link is only a warning there.
-fn link_inertia(ctx: &mut Ctx<'_>, link: &urdf_xml::Link, tol: f64, moves: bool) -> Result<Option<LinkInertia>, ModelError> {
+fn link_inertia(
+    ctx: &mut Ctx<'_>,
+    link: &urdf_xml::Link,
+    tol: f64,
+    moves: bool,
+) -> Result<Option<LinkInertia>, ModelError> {
     let Some(i) = &link.inertial else { return Ok(None) };
     let m = i.mass;
     let [xx, xy, xz, yy, yz, zz] = i.inertia;
@@ -106,7 +114,9 @@ fn collisions(ctx: &Ctx<'_>, link: &urdf_xml::Link) -> Result<Vec<Collision>, Mo
                 }
                 Shape::Sphere { radius: *radius }
             }
-            Geometry::Mesh { filename, scale } => Shape::Mesh { filename: filename.clone(), scale: Vector3::from(*scale) },
+            Geometry::Mesh { filename, scale } => {
+                Shape::Mesh { filename: filename.clone(), scale: Vector3::from(*scale) }
+            }
         };
         out.push(Collision { name: c.name.clone(), origin: c.origin, shape });
     }
@@ -170,7 +180,8 @@ fn resolve_mimics(
     moving: &[usize],
     mode: MimicMode,
 ) -> Result<Vec<(usize, f64, f64)>, ModelError> {
-    let by_name: HashMap<&str, usize> = moving.iter().enumerate().map(|(b, &ji)| (robot.joints[ji].name.as_str(), b)).collect();
+    let by_name: HashMap<&str, usize> =
+        moving.iter().enumerate().map(|(b, &ji)| (robot.joints[ji].name.as_str(), b)).collect();
     let mut out: Vec<(usize, f64, f64)> = (0..moving.len()).map(|b| (b, 1.0, 0.0)).collect();
     if mode == MimicMode::Independent {
         return Ok(out);
@@ -292,7 +303,9 @@ pub(crate) fn build(xml: &str, file: &str, options: &UrdfOptions) -> Result<Robo
                         let axis = Vector3::from(j.axis);
                         let norm = axis.norm();
                         if norm < 1e-9 {
-                            return Err(ctx.invalid(joint_el(j), format!("joint axis {:?} has (near) zero length", j.axis)));
+                            return Err(
+                                ctx.invalid(joint_el(j), format!("joint axis {:?} has (near) zero length", j.axis))
+                            );
                         }
                         limits.push(joint_limits(&ctx, j)?);
                         bodies.push(Body {
@@ -404,12 +417,8 @@ fn check_mass_matrix(ctx: &Ctx<'_>, model: &RobotModel, robot: &Urdf, moving: &[
     }
     let mut data = super::ModelData::new(model);
     let mut m = DMatrix::zeros(n, n);
-    let generic: Vec<f64> = model
-        .limits
-        .iter()
-        .enumerate()
-        .map(|(i, l)| (0.7 - 0.29 * i as f64).clamp(l.lower, l.upper))
-        .collect();
+    let generic: Vec<f64> =
+        model.limits.iter().enumerate().map(|(i, l)| (0.7 - 0.29 * i as f64).clamp(l.lower, l.upper)).collect();
     for (at, q) in [("the zero configuration", vec![0.0; n]), ("a generic configuration", generic)] {
         super::update_kinematics(model, &mut data, &q, &vec![0.0; n])?;
         super::crba(model, &mut data, &mut m)?;

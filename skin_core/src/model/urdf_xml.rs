@@ -126,7 +126,8 @@ impl Reader<'_> {
         let Some(text) = n.attribute(attr) else {
             return default.ok_or_else(|| self.invalid(self.el(owner, n), format!("missing attribute `{attr}`")));
         };
-        let bad = || self.invalid(self.el(owner, n), format!("attribute `{attr}=\"{text}\"` must be {N} finite number(s)"));
+        let bad =
+            || self.invalid(self.el(owner, n), format!("attribute `{attr}=\"{text}\"` must be {N} finite number(s)"));
         let mut out = [0.0; N];
         let mut it = text.split_whitespace();
         for o in out.iter_mut() {
@@ -224,7 +225,9 @@ impl Reader<'_> {
             other => {
                 return Err(self.invalid(
                     el,
-                    format!("unknown joint type \"{other}\" (revolute, continuous, prismatic, fixed, floating, planar)"),
+                    format!(
+                        "unknown joint type \"{other}\" (revolute, continuous, prismatic, fixed, floating, planar)"
+                    ),
                 ))
             }
         };

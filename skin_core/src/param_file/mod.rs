@@ -30,11 +30,7 @@ impl InvalidParam {
         if value.is_finite() && value > 0.0 {
             Ok(())
         } else {
-            Err(InvalidParam {
-                key: format!("{prefix}{name}"),
-                value,
-                reason: "must be finite and > 0",
-            })
+            Err(InvalidParam { key: format!("{prefix}{name}"), value, reason: "must be finite and > 0" })
         }
     }
 
@@ -50,11 +46,7 @@ impl InvalidParam {
         if value.is_finite() && (lo..=hi).contains(&value) {
             Ok(())
         } else {
-            Err(InvalidParam {
-                key: format!("{prefix}{name}"),
-                value,
-                reason,
-            })
+            Err(InvalidParam { key: format!("{prefix}{name}"), value, reason })
         }
     }
 }
@@ -102,7 +94,12 @@ pub fn load_validated<T: DeserializeOwned>(
         return parse_validated(&text, &file, validate);
     }
     let merged = read_layers(path, 0)?;
-    let p: T = serde_json::from_value(merged).map_err(|e| YamlError::Parse { file: file.clone(), line: None, column: None, message: e.to_string() })?;
+    let p: T = serde_json::from_value(merged).map_err(|e| YamlError::Parse {
+        file: file.clone(),
+        line: None,
+        column: None,
+        message: e.to_string(),
+    })?;
     validate(&p).map_err(|param| ParamsError::Invalid { file, param })?;
     Ok(p)
 }
@@ -120,7 +117,12 @@ fn read_layers(path: &Path, depth: usize) -> Result<serde_json::Value, YamlError
     let Some(base) = layer.remove(EXTENDS) else {
         return Ok(serde_json::Value::Object(layer));
     };
-    let invalid = |message: String| YamlError::Parse { file: file.clone(), line: None, column: None, message: format!("{EXTENDS}: {message}") };
+    let invalid = |message: String| YamlError::Parse {
+        file: file.clone(),
+        line: None,
+        column: None,
+        message: format!("{EXTENDS}: {message}"),
+    };
     let base = base.as_str().ok_or_else(|| invalid("must be a file name".into()))?;
     if depth >= MAX_EXTENDS_DEPTH {
         return Err(invalid(format!("more than {MAX_EXTENDS_DEPTH} files deep (a cycle?)")));

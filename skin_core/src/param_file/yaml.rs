@@ -44,10 +44,7 @@ fn strip_position(message: &str) -> &str {
     let m = message.trim().trim_start_matches("error:").trim_start();
     if m.starts_with("line ") {
         if let Some((head, rest)) = m.split_once(": ") {
-            if head
-                .split_whitespace()
-                .all(|w| w == "line" || w == "column" || w.parse::<u64>().is_ok())
-            {
+            if head.split_whitespace().all(|w| w == "line" || w == "column" || w.parse::<u64>().is_ok()) {
                 return rest;
             }
         }
@@ -82,11 +79,6 @@ pub fn parse_str<T: DeserializeOwned>(text: &str, source: &str) -> Result<T, Yam
         // The rendered message may carry a multi-line source snippet: keep the first line.
         let rendered = e.to_string();
         let message = strip_position(rendered.lines().next().unwrap_or("invalid YAML")).to_string();
-        YamlError::Parse {
-            file: source.to_string(),
-            line,
-            column,
-            message,
-        }
+        YamlError::Parse { file: source.to_string(), line, column, message }
     })
 }

@@ -1,4 +1,4 @@
-//! The resolver itself: paper 003 eq. (26) integrated exactly per step, the inner velocity loop,
+//! The resolver itself: interactive-force-control paper eq. (26) integrated exactly per step, the inner velocity loop,
 //! the limits and the safe stop, for the arms and the base at their own rates.
 
 use super::error::ResolverError;
@@ -36,11 +36,7 @@ impl Step {
         let x = c * dt / m;
         let e = (-x).exp();
         // (1 - e)/c, written so that it tends to dt/m without cancellation as c -> 0
-        let phi = if x > 1e-8 {
-            -(-x).exp_m1() / c
-        } else {
-            dt / m * (1.0 - 0.5 * x)
-        };
+        let phi = if x > 1e-8 { -(-x).exp_m1() / c } else { dt / m * (1.0 - 0.5 * x) };
         Self { e, phi }
     }
 }
@@ -56,7 +52,7 @@ struct ArmJoint {
     upper: f64,
 }
 
-/// The admittance torque resolver of paper 003 eq. (26):
+/// The admittance torque resolver of interactive-force-control paper eq. (26):
 ///
 /// ```text
 /// M_a q̈_a + C_a q̇_a + g = τ_a*        (arm joints)
@@ -129,13 +125,7 @@ impl Resolver {
             }));
         }
         let na = arm_indices.len();
-        let arm = arm_indices
-            .iter()
-            .map(|&index| ArmJoint {
-                index,
-                ..Default::default()
-            })
-            .collect();
+        let arm = arm_indices.iter().map(|&index| ArmJoint { index, ..Default::default() }).collect();
         let mut r = Self {
             params: params.clone(),
             nv: model.nv(),
@@ -149,10 +139,7 @@ impl Resolver {
             base,
             base_steps: [Step::default(); 3],
             base_dt: f64::NAN,
-            commands: Commands {
-                joint_velocities: vec![0.0; na],
-                base_twist: [0.0; 3],
-            },
+            commands: Commands { joint_velocities: vec![0.0; na], base_twist: [0.0; 3] },
             arm_indices,
         };
         r.set_params(model, params)?;
@@ -161,21 +148,12 @@ impl Resolver {
 
     /// Replaces the parameters (validated first; on error nothing changes). The virtual
     /// velocities and the last command are kept, so a gain change causes no velocity jump.
-    pub fn set_params(
-        &mut self,
-        model: &RobotModel,
-        params: ResolverParams,
-    ) -> Result<(), ResolverError> {
+    pub fn set_params(&mut self, model: &RobotModel, params: ResolverParams) -> Result<(), ResolverError> {
         params.validate()?;
         for name in params.arm.joints.keys() {
-            let ok = model
-                .joint_index(name)
-                .is_some_and(|j| self.arm_indices.contains(&j));
+            let ok = model.joint_index(name).is_some_and(|j| self.arm_indices.contains(&j));
             if !ok {
-                return Err(ResolverError::UnknownJoint {
-                    key: format!("arm.joints.{name}"),
-                    joint: name.clone(),
-                });
+                return Err(ResolverError::UnknownJoint { key: format!("arm.joints.{name}"), joint: name.clone() });
             }
         }
         let limits = model.joint_limits();
@@ -184,10 +162,7 @@ impl Resolver {
         for (a, vmax) in joints.iter_mut().zip(&mut vmax) {
             let name = &model.joint_names()[a.index];
             let lim = &limits[a.index];
-            if !(lim.velocity.is_finite() && lim.velocity > 0.0)
-                || lim.lower.is_nan()
-                || lim.upper.is_nan()
-            {
+            if !(lim.velocity.is_finite() && lim.velocity > 0.0) || lim.lower.is_nan() || lim.upper.is_nan() {
                 return Err(ResolverError::Model(format!(
                     "joint `{name}`: URDF velocity limit {} (must be finite and > 0) or position limits [{}, {}]",
                     lim.velocity, lim.lower, lim.upper
@@ -272,12 +247,7 @@ impl Resolver {
         qd_measured: &[f64],
         dt_s: f64,
     ) -> Result<&Commands, ResolverError> {
-        let inputs = [
-            ("tau", tau),
-            ("gravity", gravity),
-            ("q_measured", q_measured),
-            ("qd_measured", qd_measured),
-        ];
+        let inputs = [("tau", tau), ("gravity", gravity), ("q_measured", q_measured), ("qd_measured", qd_measured)];
         if let Err(e) = self.check_inputs(dt_s, &inputs) {
             self.safe_stop_arms(dt_s);
             return Err(e);
@@ -290,11 +260,7 @@ impl Resolver {
             self.arm_dt = dt;
         }
         let sync = -(-self.params.arm.sync_gain_per_s * dt).exp_m1();
-        let g_factor = if self.params.arm.subtract_gravity {
-            1.0
-        } else {
-            0.0
-        };
+        let g_factor = if self.params.arm.subtract_gravity { 1.0 } else { 0.0 };
         let cmd = &mut self.commands.joint_velocities;
         // Virtual dynamics into `target`: the rate limit needs the previous command.
         let target = &mut self.target;
@@ -326,11 +292,7 @@ impl Resolver {
         qd_measured: &[f64],
         dt_s: f64,
     ) -> Result<&Commands, ResolverError> {
-        let inputs = [
-            ("tau", tau),
-            ("q_measured", q_measured),
-            ("qd_measured", qd_measured),
-        ];
+        let inputs = [("tau", tau), ("q_measured", q_measured), ("qd_measured", qd_measured)];
         if let Err(e) = self.check_inputs(dt_s, &inputs) {
             self.safe_stop_base(dt_s);
             return Err(e);
@@ -355,19 +317,15 @@ impl Resolver {
         let v: [f64; 3] = core::array::from_fn(|k| prev[k] + sync * (measured[k] - prev[k]));
         let fb = to_base_frame([tau[ix], tau[iy], tau[iyaw]], yaw);
         let s = &self.base_steps;
-        let vb: [f64; 3] =
-            core::array::from_fn(|k| finite_or_max(s[k].e * v[k] + s[k].phi * fb[k]));
+        let vb: [f64; 3] = core::array::from_fn(|k| finite_or_max(s[k].e * v[k] + s[k].phi * fb[k]));
         // limits: velocity, then the rate limit against the last command in the base frame (a
         // jump of the measured yaw, an odometry reset, cannot turn the command)
         let lin = clamp_norm([vb[0], vb[1]], p.max_linear_m_s);
         let w = vb[2].clamp(-p.max_angular_rad_s, p.max_angular_rad_s);
-        let step = clamp_norm(
-            [lin[0] - prev[0], lin[1] - prev[1]],
-            p.max_linear_accel_m_s2 * dt,
-        );
+        let step = clamp_norm([lin[0] - prev[0], lin[1] - prev[1]], p.max_linear_accel_m_s2 * dt);
         let lin = clamp_norm([prev[0] + step[0], prev[1] + step[1]], p.max_linear_m_s);
-        let w = rate_limit(prev[2], w, p.max_angular_accel_rad_s2 * dt)
-            .clamp(-p.max_angular_rad_s, p.max_angular_rad_s);
+        let w =
+            rate_limit(prev[2], w, p.max_angular_accel_rad_s2 * dt).clamp(-p.max_angular_rad_s, p.max_angular_rad_s);
         self.commands.base_twist = [lin[0], lin[1], w];
         Ok(&self.commands)
     }
@@ -404,8 +362,12 @@ impl Resolver {
         let v: [f64; 3] = core::array::from_fn(|k| last[k] + s * (qd_measured[b[k]] - last[k]));
         let (sn, c) = q_measured[b[2]].sin_cos();
         let rot = nalgebra::Matrix2::new(c, -sn, sn, c);
-        let m = rot * nalgebra::Matrix2::from_diagonal(&nalgebra::Vector2::new(p.inertia[0], p.inertia[1])) * rot.transpose();
-        let d = rot * nalgebra::Matrix2::from_diagonal(&nalgebra::Vector2::new(p.damping[0], p.damping[1])) * rot.transpose();
+        let m = rot
+            * nalgebra::Matrix2::from_diagonal(&nalgebra::Vector2::new(p.inertia[0], p.inertia[1]))
+            * rot.transpose();
+        let d = rot
+            * nalgebra::Matrix2::from_diagonal(&nalgebra::Vector2::new(p.damping[0], p.damping[1]))
+            * rot.transpose();
         let f = d * nalgebra::Vector2::new(v[0], v[1]);
         for (r, &i) in b[..2].iter().enumerate() {
             for (k, &j) in b[..2].iter().enumerate() {
@@ -427,12 +389,8 @@ impl Resolver {
         qd_measured: &[f64],
         dt_s: f64,
     ) -> Result<&Commands, ResolverError> {
-        let arms = self
-            .update_arms(tau, gravity, q_measured, qd_measured, dt_s)
-            .map(|_| ());
-        let base = self
-            .update_base(tau, q_measured, qd_measured, dt_s)
-            .map(|_| ());
+        let arms = self.update_arms(tau, gravity, q_measured, qd_measured, dt_s).map(|_| ());
+        let base = self.update_base(tau, q_measured, qd_measured, dt_s).map(|_| ());
         arms.and(base)?;
         Ok(&self.commands)
     }
@@ -482,11 +440,7 @@ impl Resolver {
     }
 
     /// The period, then each named model-order vector: length and finiteness.
-    fn check_inputs(
-        &self,
-        dt_s: f64,
-        inputs: &[(&'static str, &[f64])],
-    ) -> Result<(), ResolverError> {
+    fn check_inputs(&self, dt_s: f64, inputs: &[(&'static str, &[f64])]) -> Result<(), ResolverError> {
         if !(dt_s.is_finite() && dt_s > 0.0) {
             return Err(ResolverError::InvalidDt(dt_s));
         }
@@ -495,18 +449,10 @@ impl Resolver {
 
     fn check(&self, what: &'static str, x: &[f64]) -> Result<(), ResolverError> {
         if x.len() != self.nv {
-            return Err(ResolverError::Dimension {
-                what,
-                expected: self.nv,
-                got: x.len(),
-            });
+            return Err(ResolverError::Dimension { what, expected: self.nv, got: x.len() });
         }
         match x.iter().position(|v| !v.is_finite()) {
-            Some(index) => Err(ResolverError::NonFinite {
-                what,
-                index,
-                value: x[index],
-            }),
+            Some(index) => Err(ResolverError::NonFinite { what, index, value: x[index] }),
             None => Ok(()),
         }
     }

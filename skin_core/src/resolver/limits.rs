@@ -86,9 +86,6 @@ mod tests {
         assert_eq!(position_limit(-1.0, 1.2, -1.0, 1.0, a, dt), -1.0);
         let v = position_limit(10.0, 0.9, -1.0, 1.0, a, dt);
         assert!((v * dt + v * v / (2.0 * a) - 0.1).abs() < 1e-12, "{v}");
-        assert_eq!(
-            position_limit(5.0, 0.0, f64::NEG_INFINITY, f64::INFINITY, a, dt),
-            5.0
-        );
+        assert_eq!(position_limit(5.0, 0.0, f64::NEG_INFINITY, f64::INFINITY, a, dt), 5.0);
     }
 }

@@ -1,6 +1,6 @@
-//! The admittance torque resolver of paper 003 eq. (26): torques in, joint and base velocity commands out.
+//! The admittance torque resolver of interactive-force-control paper eq. (26): torques in, joint and base velocity commands out.
 //!
-//! The fused torque `τ*` of the hierarchy (paper 003 eq. (19)) drives virtual dynamics
+//! The fused torque `τ*` of the hierarchy (interactive-force-control paper eq. (19)) drives virtual dynamics
 //! (`M_a q̈_a + C_a q̇_a + g = τ_a*` for the arm joints, `M_b ẍ_b + D_b ẋ_b = τ_b*` for the
 //! holonomic base) whose velocities, after the last-stage limits, are the commands of the
 //! velocity-controlled arms and base (TOMM: arms at 125 Hz, base at 1 kHz, each updated at its

@@ -1,4 +1,4 @@
-//! Resolver parameters (`config/resolver.yaml`): the virtual arm and base dynamics of paper 003
+//! Resolver parameters (`config/resolver.yaml`): the virtual arm and base dynamics of interactive-force-control paper
 //! eq. (26), the inner velocity loop and the last-stage limits, loaded and validated with errors
 //! naming the file and the key.
 
@@ -13,9 +13,9 @@ use crate::param_file::{load_validated, parse_validated, InvalidParam, ParamsErr
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ResolverParams {
-    /// Arm joints: `M_a q̈_a + C_a q̇_a + g = τ_a*` (paper 003 eq. (26), upper row).
+    /// Arm joints: `M_a q̈_a + C_a q̇_a + g = τ_a*` (interactive-force-control paper eq. (26), upper row).
     pub arm: ArmParams,
-    /// Holonomic base: `M_b ẍ_b + D_b ẋ_b = τ_b*` (paper 003 eq. (26), lower row).
+    /// Holonomic base: `M_b ẍ_b + D_b ẋ_b = τ_b*` (interactive-force-control paper eq. (26), lower row).
     pub base: BaseParams,
 }
 
@@ -88,25 +88,11 @@ const RATE_MIN_HZ: f64 = 1.0;
 const RATE_MAX_HZ: f64 = 100_000.0;
 
 fn non_negative(prefix: &str, name: &str, value: f64) -> Result<(), InvalidParam> {
-    InvalidParam::in_range(
-        prefix,
-        name,
-        value,
-        0.0,
-        f64::MAX,
-        "must be finite and >= 0",
-    )
+    InvalidParam::in_range(prefix, name, value, 0.0, f64::MAX, "must be finite and >= 0")
 }
 
 fn rate(prefix: &str, value: f64) -> Result<(), InvalidParam> {
-    InvalidParam::in_range(
-        prefix,
-        "rate_hz",
-        value,
-        RATE_MIN_HZ,
-        RATE_MAX_HZ,
-        "must be in [1, 100000] Hz",
-    )
+    InvalidParam::in_range(prefix, "rate_hz", value, RATE_MIN_HZ, RATE_MAX_HZ, "must be in [1, 100000] Hz")
 }
 
 impl JointOverride {
@@ -160,11 +146,7 @@ impl BaseParams {
         InvalidParam::positive_finite(prefix, "max_linear_m_s", self.max_linear_m_s)?;
         InvalidParam::positive_finite(prefix, "max_angular_rad_s", self.max_angular_rad_s)?;
         InvalidParam::positive_finite(prefix, "max_linear_accel_m_s2", self.max_linear_accel_m_s2)?;
-        InvalidParam::positive_finite(
-            prefix,
-            "max_angular_accel_rad_s2",
-            self.max_angular_accel_rad_s2,
-        )
+        InvalidParam::positive_finite(prefix, "max_angular_accel_rad_s2", self.max_angular_accel_rad_s2)
     }
 }
 

@@ -35,25 +35,13 @@ fn resolver_invalid_param_names_file_and_key() {
     let text = std::fs::read_to_string(root().join("config/resolver.yaml")).unwrap();
     let bad = text.replace("max_acceleration: 3.0", "max_acceleration: -3.0");
     assert_ne!(bad, text);
-    let e = ResolverParams::from_yaml_str(&bad, "bad.yaml")
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("bad.yaml") && e.contains("arm.max_acceleration"),
-        "{e}"
-    );
-    let bad = text.replace(
-        "damping: [100.0, 100.0, 25.0]",
-        "damping: [100.0, .nan, 25.0]",
-    );
-    let e = ResolverParams::from_yaml_str(&bad, "b.yaml")
-        .unwrap_err()
-        .to_string();
+    let e = ResolverParams::from_yaml_str(&bad, "bad.yaml").unwrap_err().to_string();
+    assert!(e.contains("bad.yaml") && e.contains("arm.max_acceleration"), "{e}");
+    let bad = text.replace("damping: [100.0, 100.0, 25.0]", "damping: [100.0, .nan, 25.0]");
+    let e = ResolverParams::from_yaml_str(&bad, "b.yaml").unwrap_err().to_string();
     assert!(e.contains("base.damping[1]"), "{e}");
     let bad = text.replace("rate_hz: 125.0", "rate_hz: 125.0\n  bogus: 1");
-    let e = ResolverParams::from_yaml_str(&bad, "c.yaml")
-        .unwrap_err()
-        .to_string();
+    let e = ResolverParams::from_yaml_str(&bad, "c.yaml").unwrap_err().to_string();
     assert!(e.starts_with("c.yaml:") && e.contains("bogus"), "{e}");
 }
 
@@ -61,29 +49,13 @@ fn resolver_invalid_param_names_file_and_key() {
 fn resolver_overrides_are_checked_against_the_model() {
     let m = model("tomm");
     let mut p = ResolverParams::default();
-    p.arm.joints.insert(
-        "base_x_joint".into(),
-        JointOverride {
-            inertia: Some(1.0),
-            ..Default::default()
-        },
-    );
+    p.arm.joints.insert("base_x_joint".into(), JointOverride { inertia: Some(1.0), ..Default::default() });
     let e = Resolver::new(&m, p.clone()).unwrap_err();
     assert!(e.to_string().contains("arm.joints.base_x_joint"), "{e}");
     p.arm.joints.clear();
-    p.arm.joints.insert(
-        "left_wrist_3_joint".into(),
-        JointOverride {
-            inertia: Some(-1.0),
-            ..Default::default()
-        },
-    );
+    p.arm.joints.insert("left_wrist_3_joint".into(), JointOverride { inertia: Some(-1.0), ..Default::default() });
     let e = Resolver::new(&m, p).unwrap_err();
-    assert!(
-        e.to_string()
-            .contains("arm.joints.left_wrist_3_joint.inertia"),
-        "{e}"
-    );
+    assert!(e.to_string().contains("arm.joints.left_wrist_3_joint.inertia"), "{e}");
 }
 
 #[test]
@@ -113,23 +85,14 @@ fn resolver_gravity_compensated_rest_stays_at_rest() {
     r.reset(&q, &qd).unwrap();
     for _ in 0..200 {
         // τ* = 0 task torque + g (eq. 19 with the bias)
-        r.update_arms(g.as_slice(), g.as_slice(), &q, &qd, ARM_DT)
-            .unwrap();
+        r.update_arms(g.as_slice(), g.as_slice(), &q, &qd, ARM_DT).unwrap();
         for _ in 0..8 {
             r.update_base(g.as_slice(), &q, &qd, BASE_DT).unwrap();
         }
     }
     let c = r.commands();
-    assert!(
-        c.joint_velocities.iter().all(|v| v.abs() < 1e-12),
-        "{:?}",
-        c.joint_velocities
-    );
-    assert!(
-        c.base_twist.iter().all(|v| v.abs() < 1e-12),
-        "{:?}",
-        c.base_twist
-    );
+    assert!(c.joint_velocities.iter().all(|v| v.abs() < 1e-12), "{:?}", c.joint_velocities);
+    assert!(c.base_twist.iter().all(|v| v.abs() < 1e-12), "{:?}", c.base_twist);
 }
 
 /// Planar7 with M = 2, C = 8 on every joint and limits far away.
@@ -157,10 +120,7 @@ fn resolver_constant_torque_gives_first_order_response() {
     r.reset(&zeros, &qd).unwrap();
     for k in 1..=500 {
         // an ideal velocity-controlled robot: the measured velocity is the last command
-        let v = r
-            .update_arms(&tau, &zeros, &zeros, &qd, ARM_DT)
-            .unwrap()
-            .joint_velocities[3];
+        let v = r.update_arms(&tau, &zeros, &zeros, &qd, ARM_DT).unwrap().joint_velocities[3];
         qd.copy_from_slice(&r.commands().joint_velocities);
         let t = k as f64 * ARM_DT;
         let exact = tau3 / c * (1.0 - (-c * t / mass).exp());
@@ -185,11 +145,7 @@ fn resolver_zero_damping_integrates_torque() {
         r.update_arms(&tau, &zeros, &zeros, &qd, ARM_DT).unwrap();
         qd.copy_from_slice(&r.commands().joint_velocities);
     }
-    assert!(
-        (qd[0] - 0.5 / 2.0 * 100.0 * ARM_DT).abs() < 1e-12,
-        "{}",
-        qd[0]
-    );
+    assert!((qd[0] - 0.5 / 2.0 * 100.0 * ARM_DT).abs() < 1e-12, "{}", qd[0]);
 }
 
 #[test]
@@ -226,12 +182,7 @@ fn resolver_arms_and_base_run_at_their_own_rates() {
     assert!((r.commands().base_twist[0] - base).abs() < 1e-9);
     // the arm torque does not move the base, the base force does not move the arm
     assert_eq!(r.commands().base_twist[1], 0.0);
-    assert!(r
-        .commands()
-        .joint_velocities
-        .iter()
-        .enumerate()
-        .all(|(i, v)| i == 2 || *v == 0.0));
+    assert!(r.commands().joint_velocities.iter().enumerate().all(|(i, v)| i == 2 || *v == 0.0));
 }
 
 #[test]
@@ -304,17 +255,11 @@ fn resolver_position_limit_blocks_outward_allows_inward() {
     let mut tau = vec![0.0; n];
     tau[1] = 10.0;
     for _ in 0..50 {
-        let v = r
-            .update_arms(&tau, &zeros, &q, &zeros, ARM_DT)
-            .unwrap()
-            .joint_velocities[1];
+        let v = r.update_arms(&tau, &zeros, &q, &zeros, ARM_DT).unwrap().joint_velocities[1];
         assert_eq!(v, 0.0);
     }
     tau[1] = -10.0;
-    let v = r
-        .update_arms(&tau, &zeros, &q, &zeros, ARM_DT)
-        .unwrap()
-        .joint_velocities[1];
+    let v = r.update_arms(&tau, &zeros, &q, &zeros, ARM_DT).unwrap().joint_velocities[1];
     assert!(v < 0.0, "{v}");
     // approaching the limit: the joint stops before it
     r.reset(&zeros, &zeros).unwrap();
@@ -324,18 +269,12 @@ fn resolver_position_limit_blocks_outward_allows_inward() {
     q[1] = upper - 0.3;
     let mut max_q: f64 = f64::MIN;
     for _ in 0..300 {
-        let v = r
-            .update_arms(&tau, &zeros, &q, &qd, ARM_DT)
-            .unwrap()
-            .joint_velocities[1];
+        let v = r.update_arms(&tau, &zeros, &q, &qd, ARM_DT).unwrap().joint_velocities[1];
         qd[1] = v;
         q[1] += v * ARM_DT;
         max_q = max_q.max(q[1]);
     }
-    assert!(
-        max_q <= upper + 1e-9 && max_q > upper - 1e-3,
-        "{max_q} vs {upper}"
-    );
+    assert!(max_q <= upper + 1e-9 && max_q > upper - 1e-3, "{max_q} vs {upper}");
 }
 
 #[test]
@@ -344,72 +283,37 @@ fn resolver_non_finite_input_errors_then_safe_stop_ramps_down() {
     let n = m.nv();
     let mut r = Resolver::new(&m, ResolverParams::default()).unwrap();
     let zeros = vec![0.0; n];
-    let qd: Vec<f64> = (0..n)
-        .map(|i| if i < 3 { 0.3 } else { 1.0 - 0.15 * i as f64 })
-        .collect();
+    let qd: Vec<f64> = (0..n).map(|i| if i < 3 { 0.3 } else { 1.0 - 0.15 * i as f64 }).collect();
     r.reset(&zeros, &qd).unwrap();
     let mut tau = vec![0.0; n];
     tau[5] = f64::NAN;
-    let e = r
-        .update_arms(&tau, &zeros, &zeros, &qd, ARM_DT)
-        .unwrap_err();
-    assert!(
-        matches!(e, ResolverError::NonFinite { what: "tau", index: 5, value } if value.is_nan()),
-        "{e}"
-    );
+    let e = r.update_arms(&tau, &zeros, &zeros, &qd, ARM_DT).unwrap_err();
+    assert!(matches!(e, ResolverError::NonFinite { what: "tau", index: 5, value } if value.is_nan()), "{e}");
     assert!(e.to_string().starts_with("tau[5] is not finite"), "{e}");
     let mut qdi = qd.clone();
     qdi[7] = f64::INFINITY;
     let e = r.update_base(&zeros, &zeros, &qdi, BASE_DT).unwrap_err();
-    assert!(
-        e.to_string().starts_with("qd_measured[7] is not finite"),
-        "{e}"
-    );
-    let e = r
-        .update_arms(&zeros, &zeros, &zeros, &zeros[..3], ARM_DT)
-        .unwrap_err();
-    assert!(
-        matches!(
-            e,
-            ResolverError::Dimension {
-                what: "qd_measured",
-                ..
-            }
-        ),
-        "{e}"
-    );
+    assert!(e.to_string().starts_with("qd_measured[7] is not finite"), "{e}");
+    let e = r.update_arms(&zeros, &zeros, &zeros, &zeros[..3], ARM_DT).unwrap_err();
+    assert!(matches!(e, ResolverError::Dimension { what: "qd_measured", .. }), "{e}");
     // the failed updates already stepped the safe stop; keep stopping
     let amax: Vec<f64> = r.arm_acceleration_limits().collect();
     let p = r.params().base;
     let mut prev = r.commands().clone();
     for _ in 0..500 {
         let c = r.safe_stop(ARM_DT).clone();
-        for ((&a, &b), &amax) in prev
-            .joint_velocities
-            .iter()
-            .zip(&c.joint_velocities)
-            .zip(&amax)
-        {
+        for ((&a, &b), &amax) in prev.joint_velocities.iter().zip(&c.joint_velocities).zip(&amax) {
             assert!(within(b - a, amax * ARM_DT) && b.abs() <= a.abs() && b * a >= 0.0);
         }
         let dl = (c.base_twist[0] - prev.base_twist[0]).hypot(c.base_twist[1] - prev.base_twist[1]);
         assert!(within(dl, p.max_linear_accel_m_s2 * ARM_DT));
         prev = c;
     }
-    assert!(prev
-        .joint_velocities
-        .iter()
-        .chain(&prev.base_twist)
-        .all(|v| *v == 0.0));
+    assert!(prev.joint_velocities.iter().chain(&prev.base_twist).all(|v| *v == 0.0));
     // a NaN dt stops with the nominal period
     r.reset(&zeros, &qd).unwrap();
-    let e = r
-        .update_arms(&zeros, &zeros, &zeros, &zeros, f64::NAN)
-        .unwrap_err();
-    assert!(
-        matches!(e, ResolverError::InvalidDt(dt) if dt.is_nan()),
-        "{e}"
-    );
+    let e = r.update_arms(&zeros, &zeros, &zeros, &zeros, f64::NAN).unwrap_err();
+    assert!(matches!(e, ResolverError::InvalidDt(dt) if dt.is_nan()), "{e}");
     let k = r.arm_joints()[0];
     assert!((r.commands().joint_velocities[0] - (qd[k] - amax[0] * ARM_DT)).abs() < 1e-12);
 }
@@ -432,20 +336,13 @@ fn resolver_reset_starts_without_jump() {
     let zeros = vec![0.0; n];
     let c = r.update(&zeros, &zeros, &q, &qd, ARM_DT).unwrap().clone();
     for (k, &j) in r.arm_joints().iter().enumerate() {
-        assert!(within(
-            c.joint_velocities[k] - qd[j],
-            p.arm.max_acceleration * ARM_DT
-        ));
+        assert!(within(c.joint_velocities[k] - qd[j], p.arm.max_acceleration * ARM_DT));
         // zero task torque: the virtual damping slows the joint by its first-order step, at most
         // at the acceleration limit
         let free = qd[j] * (-p.arm.damping / p.arm.inertia * ARM_DT).exp();
         let step = p.arm.max_acceleration * ARM_DT;
         let expected = qd[j] + (free - qd[j]).clamp(-step, step);
-        assert!(
-            (c.joint_velocities[k] - expected).abs() < 1e-12,
-            "{} vs {expected}",
-            c.joint_velocities[k]
-        );
+        assert!((c.joint_velocities[k] - expected).abs() < 1e-12, "{} vs {expected}", c.joint_velocities[k]);
     }
     // base: (0.2, -0.1) world at yaw 0.1, slowed by damping within the acceleration limit
     let (s, co) = 0.1f64.sin_cos();
@@ -471,10 +368,7 @@ fn resolver_gain_change_causes_no_jump() {
     p.arm.inertia = 0.1;
     p.arm.damping = 30.0;
     r.set_params(&m, p).unwrap();
-    let after = r
-        .update_arms(&tau, &zeros, &zeros, &qd, ARM_DT)
-        .unwrap()
-        .joint_velocities[2];
+    let after = r.update_arms(&tau, &zeros, &zeros, &qd, ARM_DT).unwrap().joint_velocities[2];
     // the velocity moves continuously from where it was towards the new steady state 3/30
     assert!(after < before && after > 0.1 - 1e-12, "{before} -> {after}");
     assert!((after - before).abs() <= 100.0 * ARM_DT);
@@ -498,22 +392,13 @@ fn resolver_velocity_scaling_keeps_the_arm_direction() {
     let c = r.update_arms(&tau, &zeros, &zeros, &zeros, ARM_DT).unwrap();
     let v = &c.joint_velocities;
     let vmax = std::f64::consts::PI * 0.5;
-    assert!(
-        (v[0] - vmax).abs() < 1e-12 && (v[1] / v[0] - 0.5).abs() < 1e-6,
-        "{v:?}"
-    );
+    assert!((v[0] - vmax).abs() < 1e-12 && (v[1] / v[0] - 0.5).abs() < 1e-6, "{v:?}");
     let free = 2.0 / 10.0 * (1.0 - (-10.0 / 0.5 * ARM_DT).exp());
     assert!((v[6] - free).abs() < 1e-12, "{v:?}");
 }
 
 fn torque() -> impl Strategy<Value = f64> {
-    prop_oneof![
-        Just(1e6),
-        Just(-1e6),
-        Just(0.0),
-        -300.0..300.0f64,
-        -1e7..1e7f64
-    ]
+    prop_oneof![Just(1e6), Just(-1e6), Just(0.0), -300.0..300.0f64, -1e7..1e7f64]
 }
 
 proptest! {

@@ -1,8 +1,8 @@
-//! Cell fusion and patch wrenches: paper 003 eq. (6), (7), (8).
+//! Cell fusion and patch wrenches: interactive-force-control paper eq. (6), (7), (8).
 //!
-//! Sign convention (paper 003): the cell's virtual force `sF` acts along the +z axis of the cell
+//! Sign convention (interactive-force-control paper): the cell's virtual force `sF` acts along the +z axis of the cell
 //! frame, i.e. along the OUTWARD normal. The physical force that a touch exerts on the robot
-//! points inward; controllers react with `-K F` (paper 003 eq. (12)) to yield to it.
+//! points inward; controllers react with `-K F` (interactive-force-control paper eq. (12)) to yield to it.
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -10,8 +10,8 @@ use thiserror::Error;
 
 use super::layout::ResolvedLayout;
 use super::live::LiveCells;
-use crate::param_file::InvalidParam;
 use super::signals::{CellReading, ForceReduction};
+use crate::param_file::InvalidParam;
 
 /// A per-cell input slice whose length does not match the layout.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
@@ -36,20 +36,16 @@ impl LengthMismatch {
         if got == layout.cells().len() {
             Ok(())
         } else {
-            Err(LengthMismatch {
-                what: "cell readings",
-                expected: layout.cells().len(),
-                got,
-            })
+            Err(LengthMismatch { what: "cell readings", expected: layout.cells().len(), got })
         }
     }
 }
 
-/// Parameters of the force/proximity fusion (paper 003 eq. (6)) and of cell activity.
+/// Parameters of the force/proximity fusion (interactive-force-control paper eq. (6)) and of cell activity.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FusionParams {
-    /// `w` of paper 003 eq. (6) in [0, 1]: 0 = proximity only, 1 = force only.
+    /// `w` of interactive-force-control paper eq. (6) in [0, 1]: 0 = proximity only, 1 = force only.
     pub weight_force: f64,
     /// A cell is active when its fused signal `sF` exceeds this value, in [0, 1).
     pub activity_threshold: f64,
@@ -61,14 +57,7 @@ pub struct FusionParams {
 impl FusionParams {
     /// Checks `weight_force` in [0, 1] and `activity_threshold` in [0, 1).
     pub fn validate(&self, prefix: &str) -> Result<(), InvalidParam> {
-        InvalidParam::in_range(
-            prefix,
-            "weight_force",
-            self.weight_force,
-            0.0,
-            1.0,
-            "must be in [0, 1]",
-        )?;
+        InvalidParam::in_range(prefix, "weight_force", self.weight_force, 0.0, 1.0, "must be in [0, 1]")?;
         InvalidParam::in_range(
             prefix,
             "activity_threshold",
@@ -80,29 +69,25 @@ impl FusionParams {
     }
 }
 
-/// Paper 003 eq. (6): the cell's virtual force `sF = w f + (1 - w) p` (signals in [0, 1]).
+/// Interactive-force-control paper eq. (6): the cell's virtual force `sF = w f + (1 - w) p` (signals in [0, 1]).
 #[inline]
 pub fn fuse(force_signal: f64, proximity_signal: f64, weight_force: f64) -> f64 {
     weight_force * force_signal + (1.0 - weight_force) * proximity_signal
 }
 
-/// Fused virtual force of one reading (sanitized signals, paper 003 eq. (6)).
+/// Fused virtual force of one reading (sanitized signals, interactive-force-control paper eq. (6)).
 #[inline]
 pub fn cell_virtual_force(reading: &CellReading, fusion: &FusionParams) -> f64 {
-    fuse(
-        reading.force_signal(fusion.force_reduction),
-        reading.proximity_signal(),
-        fusion.weight_force,
-    )
+    fuse(reading.force_signal(fusion.force_reduction), reading.proximity_signal(), fusion.weight_force)
 }
 
 /// The equivalent wrench of one patch in its patch frame {p_j}, with activity statistics.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct PatchWrench {
-    /// Paper 003 eq. (7): sum of the active cells' virtual forces `R sF` (outward normals),
+    /// Interactive-force-control paper eq. (7): sum of the active cells' virtual forces `R sF` (outward normals),
     /// in the patch frame (units of the normalized signals).
     pub force: Vector3<f64>,
-    /// Paper 003 eq. (8): sum of `t × R sF` about the patch frame origin, in the patch frame.
+    /// Interactive-force-control paper eq. (8): sum of `t × R sF` about the patch frame origin, in the patch frame.
     pub moment: Vector3<f64>,
     /// Mean position of the active cells in the patch frame \[m\] (zero when none is active).
     pub centroid: Vector3<f64>,
@@ -115,7 +100,7 @@ pub struct PatchWrench {
 }
 
 /// Aggregates the cells of patch `patch` (index into `layout.patches()`) into its wrench
-/// (paper 003 eq. (6)-(8)). `readings` is indexed like `layout.cells()`. No allocation.
+/// (interactive-force-control paper eq. (6)-(8)). `readings` is indexed like `layout.cells()`. No allocation.
 pub fn aggregate_patch(
     layout: &ResolvedLayout,
     patch: usize,
@@ -126,7 +111,7 @@ pub fn aggregate_patch(
     Ok(aggregate_range(layout, patch, all_cells(layout, patch, readings), fusion))
 }
 
-/// Aggregates every patch (paper 003 eq. (6)-(8)) into `out`, indexed like `layout.patches()`.
+/// Aggregates every patch (interactive-force-control paper eq. (6)-(8)) into `out`, indexed like `layout.patches()`.
 /// `out` is resized to the number of patches (allocates only if its capacity is too small, i.e.
 /// on the first call); `readings` is indexed like `layout.cells()`.
 pub fn aggregate_patches(
@@ -192,7 +177,7 @@ fn aggregate_range<'a>(
         let p = r.proximity_signal();
         w.max_force_signal = w.max_force_signal.max(f);
         w.max_proximity_signal = w.max_proximity_signal.max(p);
-        // Paper 003 eq. (6).
+        // Interactive-force-control paper eq. (6).
         let s = wf * f + wp * p;
         if s > fusion.activity_threshold {
             // {p}R_{s_i} [0 0 sF]^T = n_i sF (eq. 7); t_i × n_i sF = (t_i × n_i) sF (eq. 8).
@@ -215,18 +200,11 @@ mod tests {
     use approx::assert_relative_eq;
 
     fn fusion(w: f64) -> FusionParams {
-        FusionParams {
-            weight_force: w,
-            activity_threshold: 0.01,
-            force_reduction: ForceReduction::Mean,
-        }
+        FusionParams { weight_force: w, activity_threshold: 0.01, force_reduction: ForceReduction::Mean }
     }
 
     fn layout(text: &str) -> ResolvedLayout {
-        SkinLayout::from_yaml_str(text, "t.yaml")
-            .unwrap()
-            .resolve_with(|_| Some(0))
-            .unwrap()
+        SkinLayout::from_yaml_str(text, "t.yaml").unwrap().resolve_with(|_| Some(0)).unwrap()
     }
 
     #[test]
@@ -240,11 +218,7 @@ mod tests {
         let s = 0.25 * 0.8 + 0.75 * 0.4;
         assert_relative_eq!(w.force, Vector3::new(0.0, 0.0, s), epsilon = 1e-15);
         // t × (0,0,s) = (ty s, -tx s, 0)
-        assert_relative_eq!(
-            w.moment,
-            Vector3::new(0.02 * s, -0.1 * s, 0.0),
-            epsilon = 1e-15
-        );
+        assert_relative_eq!(w.moment, Vector3::new(0.02 * s, -0.1 * s, 0.0), epsilon = 1e-15);
         assert_eq!(w.active_cells, 1);
         assert_relative_eq!(w.centroid, Vector3::new(0.1, 0.02, 0.03));
         assert_relative_eq!(w.max_force_signal, 0.8, epsilon = 1e-15);
@@ -273,8 +247,7 @@ mod tests {
     fn symmetric_pattern_has_no_moment() {
         // A flat 5x5 grid centred on the patch origin, normals +z, uniform signals; plus a ring
         // of radial cells on a cylinder about z, symmetric about the origin.
-        let mut text =
-            String::from("patches:\n  - {id: 1, link: a}\n  - {id: 2, link: b}\ncells:\n");
+        let mut text = String::from("patches:\n  - {id: 1, link: a}\n  - {id: 2, link: b}\ncells:\n");
         let mut id = 0;
         for i in -2..=2 {
             for j in -2..=2 {
@@ -305,11 +278,7 @@ mod tests {
         aggregate_patches(&l, &r, &fusion(0.5), &mut out).unwrap();
         assert_eq!(out.len(), 2);
         assert_relative_eq!(out[0].moment, Vector3::zeros(), epsilon = 1e-12);
-        assert_relative_eq!(
-            out[0].force,
-            Vector3::new(0.0, 0.0, 25.0 * 0.5),
-            epsilon = 1e-12
-        );
+        assert_relative_eq!(out[0].force, Vector3::new(0.0, 0.0, 25.0 * 0.5), epsilon = 1e-12);
         assert_eq!(out[0].active_cells, 25);
         assert_relative_eq!(out[1].moment, Vector3::zeros(), epsilon = 1e-12);
         assert_relative_eq!(out[1].force, Vector3::zeros(), epsilon = 1e-12);

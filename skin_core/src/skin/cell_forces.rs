@@ -1,5 +1,5 @@
-//! Per-cell Cartesian forces in the world frame: proximity repulsion (paper 000 eq. (3)) and
-//! measured contact forces (paper 000 eq. (6)), ready for `J^T F` ([`super::torques`]).
+//! Per-cell Cartesian forces in the world frame: proximity repulsion (intentional-contact paper eq. (3)) and
+//! measured contact forces (intentional-contact paper eq. (6)), ready for `J^T F` ([`super::torques`]).
 //!
 //! Both forces act ON the robot and point INWARD (along the cell's -normal): the obstacle or the
 //! touching object is outside, along +normal, so the repulsion pushes the link away from it and
@@ -26,7 +26,7 @@ pub struct PointForce {
     pub force: Vector3<f64>,
 }
 
-/// Paper 000 eq. (3) per cell: distance `d_i` from the proximity signal through the inverse
+/// Intentional-contact paper eq. (3) per cell: distance `d_i` from the proximity signal through the inverse
 /// characteristic, magnitude `K (d_range - d_i)` for `d_i < d_range`, direction `-n_i` (world).
 /// `frame_pose(frame)` gives the world pose of a link frame (kinematics already updated).
 /// `out` is cleared and filled with one entry per repelled cell; reserve
@@ -49,7 +49,7 @@ pub fn cell_repulsion_forces<'a>(
     })
 }
 
-/// Measured contact forces per cell (paper 000 eq. (6)): cells whose force signal (reduced per
+/// Measured contact forces per cell (intentional-contact paper eq. (6)): cells whose force signal (reduced per
 /// `fusion.force_reduction`) exceeds `fusion.activity_threshold` give `-n_i F_i` with `F_i` \[N\]
 /// from the inverse force characteristic. Same `frame_pose` and `out` conventions as
 /// [`cell_repulsion_forces`].

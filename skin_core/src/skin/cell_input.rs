@@ -86,11 +86,7 @@ pub struct Issue {
 
 impl fmt::Display for Issue {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "cells[{}] (cell {}) {}",
-            self.index, self.cell_id, self.field
-        )?;
+        write!(f, "cells[{}] (cell {}) {}", self.index, self.cell_id, self.field)?;
         if let Some(v) = self.value {
             write!(f, " = {v}")?;
         }
@@ -188,13 +184,7 @@ impl CellBuffer {
             report(&issue);
         };
         for (index, cell) in cells.into_iter().enumerate() {
-            let id_issue = |kind| Issue {
-                kind,
-                index,
-                cell_id: cell.cell_id,
-                field: "cell_id",
-                value: None,
-            };
+            let id_issue = |kind| Issue { kind, index, cell_id: cell.cell_id, field: "cell_id", value: None };
             let Some(k) = layout.cell_index(cell.cell_id) else {
                 note(&mut self.issues, id_issue(IssueKind::UnknownId));
                 continue;
@@ -213,26 +203,13 @@ impl CellBuffer {
                 }
             }
             if cell.force.len() != 3 {
-                note(
-                    &mut self.issues,
-                    Issue {
-                        field: "force",
-                        ..id_issue(IssueKind::Malformed)
-                    },
-                );
+                note(&mut self.issues, Issue { field: "force", ..id_issue(IssueKind::Malformed) });
             }
             let mut signal = |field: &'static str, raw: Option<&f32>| {
                 let raw = raw.copied().unwrap_or(0.0);
                 let (value, kind) = sanitize(raw);
                 if let Some(kind) = kind {
-                    note(
-                        &mut self.issues,
-                        Issue {
-                            field,
-                            value: Some(raw),
-                            ..id_issue(kind)
-                        },
-                    );
+                    note(&mut self.issues, Issue { field, value: Some(raw), ..id_issue(kind) });
                 }
                 value
             };
@@ -276,11 +253,7 @@ mod tests {
 
     fn update(buf: &mut CellBuffer, l: &ResolvedLayout, msg: &[Cell]) -> Vec<Issue> {
         let mut issues = Vec::new();
-        let cells = msg.iter().map(|c| CellSample {
-            cell_id: c.0,
-            force: &c.1,
-            proximity: c.2,
-        });
+        let cells = msg.iter().map(|c| CellSample { cell_id: c.0, force: &c.1, proximity: c.2 });
         buf.update(l, cells, |i| issues.push(*i));
         issues
     }
@@ -291,23 +264,10 @@ mod tests {
         let mut buf = CellBuffer::new(&l);
         assert!(update(&mut buf, &l, &[cell(20, [0.5, 0.25, 1.0], 0.75)]).is_empty());
         let k20 = l.cell_index(20).unwrap();
-        assert_eq!(
-            buf.readings()[k20],
-            CellReading {
-                force: [0.5, 0.25, 1.0],
-                proximity: 0.75
-            }
-        );
+        assert_eq!(buf.readings()[k20], CellReading { force: [0.5, 0.25, 1.0], proximity: 0.75 });
         assert!(update(&mut buf, &l, &[cell(10, [0.0; 3], 0.5)]).is_empty());
-        assert_eq!(
-            buf.readings()[k20].proximity,
-            0.75,
-            "absent cell keeps its last reading"
-        );
-        assert_eq!(
-            buf.readings()[l.cell_index(11).unwrap()],
-            CellReading::default()
-        );
+        assert_eq!(buf.readings()[k20].proximity, 0.75, "absent cell keeps its last reading");
+        assert_eq!(buf.readings()[l.cell_index(11).unwrap()], CellReading::default());
         assert_eq!(buf.issues().total(), 0);
     }
 
@@ -323,14 +283,7 @@ mod tests {
         ];
         let issues = update(&mut buf, &l, &msg);
         let r10 = buf.readings()[l.cell_index(10).unwrap()];
-        assert_eq!(
-            r10,
-            CellReading {
-                force: [0.0, 0.5, 0.0],
-                proximity: 1.0
-            },
-            "first wins"
-        );
+        assert_eq!(r10, CellReading { force: [0.0, 0.5, 0.0], proximity: 1.0 }, "first wins");
         let r11 = buf.readings()[l.cell_index(11).unwrap()];
         assert_eq!(r11.force[1], 0.0);
         assert_eq!(r11.proximity, 0.0);
@@ -352,35 +305,12 @@ mod tests {
     fn empty_and_long_force_arrays_are_malformed_but_read() {
         let l = layout();
         let mut buf = CellBuffer::new(&l);
-        let issues = update(
-            &mut buf,
-            &l,
-            &[
-                Cell(10, vec![], 0.5),
-                Cell(11, vec![0.1, 0.2, 0.3, f32::NAN], 0.5),
-            ],
-        );
-        let kinds: Vec<_> = issues
-            .iter()
-            .map(|i| (i.cell_id, i.kind, i.field))
-            .collect();
-        assert_eq!(
-            kinds,
-            [
-                (10, IssueKind::Malformed, "force"),
-                (11, IssueKind::Malformed, "force")
-            ]
-        );
-        assert_eq!(
-            buf.readings()[l.cell_index(10).unwrap()],
-            CellReading::uniform(0.0, 0.5)
-        );
+        let issues = update(&mut buf, &l, &[Cell(10, vec![], 0.5), Cell(11, vec![0.1, 0.2, 0.3, f32::NAN], 0.5)]);
+        let kinds: Vec<_> = issues.iter().map(|i| (i.cell_id, i.kind, i.field)).collect();
+        assert_eq!(kinds, [(10, IssueKind::Malformed, "force"), (11, IssueKind::Malformed, "force")]);
+        assert_eq!(buf.readings()[l.cell_index(10).unwrap()], CellReading::uniform(0.0, 0.5));
         let r11 = buf.readings()[l.cell_index(11).unwrap()];
-        assert_eq!(
-            r11.force,
-            [0.1f32, 0.2, 0.3].map(f64::from),
-            "the extra NaN is ignored"
-        );
+        assert_eq!(r11.force, [0.1f32, 0.2, 0.3].map(f64::from), "the extra NaN is ignored");
         assert_eq!(
             buf.issues().to_string(),
             "unknown cell id: 0, duplicate cell id: 0, non-finite signal: 0, signal outside [0, 1]: 0, \
@@ -392,18 +322,12 @@ mod tests {
     fn huge_and_tiny_values_stay_in_unit_range() {
         let l = layout();
         let mut buf = CellBuffer::new(&l);
-        let msg = [
-            cell(10, [f32::MAX, f32::MIN, -0.0], f32::MIN_POSITIVE),
-            cell(u32::MAX, [0.0; 3], 0.0),
-        ];
+        let msg = [cell(10, [f32::MAX, f32::MIN, -0.0], f32::MIN_POSITIVE), cell(u32::MAX, [0.0; 3], 0.0)];
         let issues = update(&mut buf, &l, &msg);
         assert_eq!(issues.len(), 3, "{issues:?}");
         let r = buf.readings()[l.cell_index(10).unwrap()];
         assert_eq!(r.force, [1.0, 0.0, 0.0]);
-        assert!(
-            r.force[2].is_sign_negative(),
-            "-0.0 is in range and kept as is"
-        );
+        assert!(r.force[2].is_sign_negative(), "-0.0 is in range and kept as is");
         assert_eq!(r.proximity, f64::from(f32::MIN_POSITIVE));
     }
 }

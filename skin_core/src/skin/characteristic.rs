@@ -1,7 +1,7 @@
 //! Normalized [0, 1] characteristics of the skin cells' proximity and force sensors and their
 //! inverses.
 //!
-//! Paper 003 Sec. 2.3: both signals are normalized to [0, 1], the proximity signal is maximal when
+//! Interactive-force-control paper Sec. 2.3: both signals are normalized to [0, 1], the proximity signal is maximal when
 //! the sensor touches a surface, and both sensors are nonlinear with the highest sensitivity at
 //! short distances and low forces, saturating at larger magnitudes. Both characteristics here are
 //! normalized, truncated exponentials:
@@ -63,12 +63,7 @@ impl ProximityCharacteristic {
     #[inline]
     pub fn prepared(&self) -> PreparedProximity {
         let x = -self.range_m / self.decay_m;
-        PreparedProximity {
-            range_m: self.range_m,
-            decay_m: self.decay_m,
-            tail: x.exp(),
-            norm: -x.exp_m1(),
-        }
+        PreparedProximity { range_m: self.range_m, decay_m: self.decay_m, tail: x.exp(), norm: -x.exp_m1() }
     }
 
     /// Signal for a distance \[m\]; see [`PreparedProximity::signal`].
@@ -156,11 +151,7 @@ impl ForceCharacteristic {
     /// The characteristic with its constant precomputed, for evaluating many cells per cycle.
     #[inline]
     pub fn prepared(&self) -> PreparedForce {
-        PreparedForce {
-            scale_n: self.scale_n,
-            max_n: self.max_n,
-            span: (-self.max_n / self.scale_n).exp_m1(),
-        }
+        PreparedForce { scale_n: self.scale_n, max_n: self.max_n, span: (-self.max_n / self.scale_n).exp_m1() }
     }
 
     /// Signal for a force \[N\]; see [`PreparedForce::signal`].
@@ -219,14 +210,8 @@ mod tests {
     use super::*;
     use approx::assert_relative_eq;
 
-    const PROX: ProximityCharacteristic = ProximityCharacteristic {
-        range_m: 0.15,
-        decay_m: 0.03,
-    };
-    const FORCE: ForceCharacteristic = ForceCharacteristic {
-        scale_n: 2.0,
-        max_n: 10.0,
-    };
+    const PROX: ProximityCharacteristic = ProximityCharacteristic { range_m: 0.15, decay_m: 0.03 };
+    const FORCE: ForceCharacteristic = ForceCharacteristic { scale_n: 2.0, max_n: 10.0 };
 
     #[test]
     fn proximity_ends_and_inverse() {
@@ -250,16 +235,10 @@ mod tests {
         for k in 0..=n {
             let d = PROX.range_m * k as f64 / n as f64;
             let p = PROX.signal(d);
-            assert!(
-                p < last || k == 0 || (p == 0.0 && last == 0.0),
-                "not decreasing at {d}"
-            );
+            assert!(p < last || k == 0 || (p == 0.0 && last == 0.0), "not decreasing at {d}");
             if k > 0 {
                 let slope = last - p;
-                assert!(
-                    slope <= last_slope + 1e-15,
-                    "sensitivity grows with distance at {d}"
-                );
+                assert!(slope <= last_slope + 1e-15, "sensitivity grows with distance at {d}");
                 last_slope = slope;
             }
             last = p;
@@ -306,10 +285,7 @@ mod tests {
             assert!(s > last, "not increasing at {f}");
             if k > 0 {
                 let slope = s - last;
-                assert!(
-                    slope <= last_slope + 1e-15,
-                    "sensitivity grows with force at {f}"
-                );
+                assert!(slope <= last_slope + 1e-15, "sensitivity grows with force at {f}");
                 last_slope = slope;
             }
             last = s;
@@ -331,16 +307,10 @@ mod tests {
 
     #[test]
     fn validation_names_the_key() {
-        let bad = ProximityCharacteristic {
-            range_m: 0.1,
-            decay_m: 0.0,
-        };
+        let bad = ProximityCharacteristic { range_m: 0.1, decay_m: 0.0 };
         let e = bad.validate("proximity.").unwrap_err();
         assert_eq!(e.key, "proximity.decay_m");
-        let bad = ForceCharacteristic {
-            scale_n: f64::NAN,
-            max_n: 1.0,
-        };
+        let bad = ForceCharacteristic { scale_n: f64::NAN, max_n: 1.0 };
         let e = bad.validate("force.").unwrap_err();
         assert_eq!(e.key, "force.scale_n");
     }

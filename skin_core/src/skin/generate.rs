@@ -25,27 +25,15 @@ impl FromStr for LinkSelection {
     fn from_str(s: &str) -> Result<Self, String> {
         let s = s.trim();
         match s.split_once(':') {
-            None if !s.is_empty() => Ok(LinkSelection {
-                link: s.to_string(),
-                collisions: None,
-            }),
+            None if !s.is_empty() => Ok(LinkSelection { link: s.to_string(), collisions: None }),
             Some((link, idx)) if !link.is_empty() => {
                 let collisions = idx
                     .split('+')
-                    .map(|i| {
-                        i.trim()
-                            .parse::<usize>()
-                            .map_err(|_| format!("bad collision index `{i}` in `{s}`"))
-                    })
+                    .map(|i| i.trim().parse::<usize>().map_err(|_| format!("bad collision index `{i}` in `{s}`")))
                     .collect::<Result<Vec<_>, _>>()?;
-                Ok(LinkSelection {
-                    link: link.to_string(),
-                    collisions: Some(collisions),
-                })
+                Ok(LinkSelection { link: link.to_string(), collisions: Some(collisions) })
             }
-            _ => Err(format!(
-                "bad link selection `{s}` (use `link` or `link:0+2`)"
-            )),
+            _ => Err(format!("bad link selection `{s}` (use `link` or `link:0+2`)")),
         }
     }
 }
@@ -125,10 +113,7 @@ fn tile_shape(shape: &Shape, faces: &[Face], spheres: bool, pitch: f64) -> Vec<T
 
 /// Tiles the selected links of `model` (see [`super::tiling`] for the rules). Patch ids and
 /// cell ids count from 1 in output order; deterministic for a given model and spec.
-pub fn generate_layout(
-    model: &RobotModel,
-    spec: &GeneratorSpec,
-) -> Result<SkinLayout, GenerateError> {
+pub fn generate_layout(model: &RobotModel, spec: &GeneratorSpec) -> Result<SkinLayout, GenerateError> {
     if !(spec.pitch_m.is_finite() && spec.pitch_m > 0.0) {
         return Err(GenerateError::BadPitch(spec.pitch_m));
     }
@@ -138,22 +123,14 @@ pub fn generate_layout(
     for sel in &spec.links {
         let frame = model
             .frame_index(&sel.link)
-            .ok_or_else(|| GenerateError::UnknownLink {
-                urdf: urdf.clone(),
-                link: sel.link.clone(),
-            })?;
+            .ok_or_else(|| GenerateError::UnknownLink { urdf: urdf.clone(), link: sel.link.clone() })?;
         let count = model.link_collisions(frame).len();
         let idx: Vec<usize> = match &sel.collisions {
             None => (0..count).collect(),
             Some(v) => v.clone(),
         };
         if let Some(&index) = idx.iter().find(|&&i| i >= count) {
-            return Err(GenerateError::BadCollisionIndex {
-                urdf,
-                link: sel.link.clone(),
-                index,
-                count,
-            });
+            return Err(GenerateError::BadCollisionIndex { urdf, link: sel.link.clone(), index, count });
         }
         match order.iter_mut().find(|(l, _)| *l == sel.link) {
             Some((_, v)) => {
@@ -166,21 +143,13 @@ pub fn generate_layout(
             None => order.push((sel.link.clone(), idx)),
         }
     }
-    let mut layout = SkinLayout {
-        source: urdf.clone(),
-        robot: Some(model.name().to_string()),
-        ..Default::default()
-    };
+    let mut layout = SkinLayout { source: urdf.clone(), robot: Some(model.name().to_string()), ..Default::default() };
     let mut next_cell = 1u32;
     for (k, (link, idx)) in order.iter().enumerate() {
         let frame = model.frame_index(link).expect("checked above");
         let collisions = model.link_collisions(frame);
-        let faces: &[Face] = spec
-            .faces
-            .iter()
-            .find(|(l, _)| l == link)
-            .map(|(_, f)| f.as_slice())
-            .unwrap_or(&Face::ALL);
+        let faces: &[Face] =
+            spec.faces.iter().find(|(l, _)| l == link).map(|(_, f)| f.as_slice()).unwrap_or(&Face::ALL);
         let link_from_patch = match (spec.patch_frame, idx.first()) {
             (PatchFrame::Primitive, Some(&i)) => collisions[i].origin,
             _ => Isometry3::identity(),
@@ -204,10 +173,7 @@ pub fn generate_layout(
             }
         }
         if layout.cells.len() == first_cell {
-            return Err(GenerateError::NoCells {
-                urdf,
-                link: link.clone(),
-            });
+            return Err(GenerateError::NoCells { urdf, link: link.clone() });
         }
         let (roll, pitch, yaw) = link_from_patch.rotation.euler_angles();
         let t = link_from_patch.translation.vector;
@@ -228,19 +194,10 @@ mod tests {
 
     #[test]
     fn parse_link_selection() {
-        assert_eq!(
-            "a".parse::<LinkSelection>().unwrap(),
-            LinkSelection {
-                link: "a".into(),
-                collisions: None
-            }
-        );
+        assert_eq!("a".parse::<LinkSelection>().unwrap(), LinkSelection { link: "a".into(), collisions: None });
         assert_eq!(
             "arm:0+2".parse::<LinkSelection>().unwrap(),
-            LinkSelection {
-                link: "arm".into(),
-                collisions: Some(vec![0, 2])
-            }
+            LinkSelection { link: "arm".into(), collisions: Some(vec![0, 2]) }
         );
         assert!(":1".parse::<LinkSelection>().is_err());
         assert!("a:x".parse::<LinkSelection>().is_err());

@@ -24,8 +24,8 @@ use serde_saphyr::Spanned;
 use thiserror::Error;
 
 pub use super::resolved::{ResolvedCell, ResolvedLayout, ResolvedPatch};
-use crate::param_file::yaml::{self, YamlError};
 use crate::model::RobotModel;
+use crate::param_file::yaml::{self, YamlError};
 
 /// One skin patch: a rigid group of cells on one link, with its own frame {p_j}.
 #[derive(Debug, Clone, PartialEq)]
@@ -181,12 +181,7 @@ impl fmt::Display for LayoutError {
 
 impl LayoutError {
     fn new(file: &str, line: Option<u64>, element: String, kind: LayoutErrorKind) -> Self {
-        LayoutError {
-            file: file.to_string(),
-            line,
-            element,
-            kind,
-        }
+        LayoutError { file: file.to_string(), line, element, kind }
     }
 }
 
@@ -196,12 +191,7 @@ impl From<YamlError> for LayoutError {
             YamlError::Io { file, .. } => (file.clone(), None),
             YamlError::Parse { file, line, .. } => (file.clone(), *line),
         };
-        LayoutError {
-            file,
-            line,
-            element: "document".into(),
-            kind: LayoutErrorKind::Yaml(Box::new(e)),
-        }
+        LayoutError { file, line, element: "document".into(), kind: LayoutErrorKind::Yaml(Box::new(e)) }
     }
 }
 
@@ -210,11 +200,7 @@ impl From<YamlError> for LayoutError {
 /// x (`|n.x| > 0.9`); y = z × x. Deterministic for a given normal.
 pub fn cell_rotation(n: &Unit<Vector3<f64>>) -> Rotation3<f64> {
     let z = n.into_inner();
-    let reference = if z.x.abs() > 0.9 {
-        Vector3::y()
-    } else {
-        Vector3::x()
-    };
+    let reference = if z.x.abs() > 0.9 { Vector3::y() } else { Vector3::x() };
     let x = (reference - z * z.dot(&reference)).normalize();
     let y = z.cross(&x);
     Rotation3::from_basis_unchecked(&[x, y, z])
@@ -238,13 +224,7 @@ impl SkinLayout {
             patches: raw
                 .patches
                 .into_iter()
-                .map(|p| PatchSpec {
-                    line: line_of(&p.id),
-                    id: p.id.value,
-                    link: p.link,
-                    xyz: p.xyz,
-                    rpy: p.rpy,
-                })
+                .map(|p| PatchSpec { line: line_of(&p.id), id: p.id.value, link: p.link, xyz: p.xyz, rpy: p.rpy })
                 .collect(),
             cells: raw
                 .cells
@@ -265,12 +245,8 @@ impl SkinLayout {
     /// Reads, parses and validates the layout file at `path`.
     pub fn load(path: &Path) -> Result<Self, LayoutError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| {
-            LayoutError::from(YamlError::Io {
-                file: file.clone(),
-                source,
-            })
-        })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| LayoutError::from(YamlError::Io { file: file.clone(), source }))?;
         Self::from_yaml_str(&text, &file)
     }
 
@@ -279,20 +255,10 @@ impl SkinLayout {
     pub fn validate(&self) -> Result<(), LayoutError> {
         let file = self.source.as_str();
         if self.patches.is_empty() {
-            return Err(LayoutError::new(
-                file,
-                None,
-                "patches".into(),
-                LayoutErrorKind::Empty("patches"),
-            ));
+            return Err(LayoutError::new(file, None, "patches".into(), LayoutErrorKind::Empty("patches")));
         }
         if self.cells.is_empty() {
-            return Err(LayoutError::new(
-                file,
-                None,
-                "cells".into(),
-                LayoutErrorKind::Empty("cells"),
-            ));
+            return Err(LayoutError::new(file, None, "cells".into(), LayoutErrorKind::Empty("cells")));
         }
         let mut patch_lines: HashMap<u32, Option<u64>> = HashMap::with_capacity(self.patches.len());
         for p in &self.patches {
@@ -302,28 +268,13 @@ impl SkinLayout {
                 return Err(LayoutError::new(file, p.line, element, kind));
             }
             if p.link.trim().is_empty() {
-                return Err(LayoutError::new(
-                    file,
-                    p.line,
-                    element,
-                    LayoutErrorKind::UnknownLink(p.link.clone()),
-                ));
+                return Err(LayoutError::new(file, p.line, element, LayoutErrorKind::UnknownLink(p.link.clone())));
             }
             if !p.xyz.iter().all(|v| v.is_finite()) {
-                return Err(LayoutError::new(
-                    file,
-                    p.line,
-                    element,
-                    LayoutErrorKind::NonFinite("xyz"),
-                ));
+                return Err(LayoutError::new(file, p.line, element, LayoutErrorKind::NonFinite("xyz")));
             }
             if !p.rpy.iter().all(|v| v.is_finite()) {
-                return Err(LayoutError::new(
-                    file,
-                    p.line,
-                    element,
-                    LayoutErrorKind::NonFinite("rpy"),
-                ));
+                return Err(LayoutError::new(file, p.line, element, LayoutErrorKind::NonFinite("rpy")));
             }
         }
         let mut cell_lines: HashMap<u32, Option<u64>> = HashMap::with_capacity(self.cells.len());
@@ -334,30 +285,15 @@ impl SkinLayout {
                 return Err(LayoutError::new(file, c.line, element, kind));
             }
             if !patch_lines.contains_key(&c.patch) {
-                return Err(LayoutError::new(
-                    file,
-                    c.line,
-                    element,
-                    LayoutErrorKind::UnknownPatch(c.patch),
-                ));
+                return Err(LayoutError::new(file, c.line, element, LayoutErrorKind::UnknownPatch(c.patch)));
             }
             if !c.position.iter().all(|v| v.is_finite()) {
-                return Err(LayoutError::new(
-                    file,
-                    c.line,
-                    element,
-                    LayoutErrorKind::NonFinite("position"),
-                ));
+                return Err(LayoutError::new(file, c.line, element, LayoutErrorKind::NonFinite("position")));
             }
             let n = Vector3::from(c.normal);
             let norm = n.norm();
             if !norm.is_finite() || norm < 1e-9 {
-                return Err(LayoutError::new(
-                    file,
-                    c.line,
-                    element,
-                    LayoutErrorKind::BadNormal(c.normal),
-                ));
+                return Err(LayoutError::new(file, c.line, element, LayoutErrorKind::BadNormal(c.normal)));
             }
         }
         Ok(())
@@ -371,22 +307,14 @@ impl SkinLayout {
     /// Resolves the layout with a link-name -> frame-index lookup (see [`Self::resolve`]).
     /// Validates first. Patches keep the file order; cells are grouped by patch, in file order
     /// within a patch.
-    pub fn resolve_with(
-        &self,
-        frame_of: impl Fn(&str) -> Option<usize>,
-    ) -> Result<ResolvedLayout, LayoutError> {
+    pub fn resolve_with(&self, frame_of: impl Fn(&str) -> Option<usize>) -> Result<ResolvedLayout, LayoutError> {
         self.validate()?;
         let file = self.source.as_str();
         let mut patches = Vec::with_capacity(self.patches.len());
         let mut patch_index: HashMap<u32, usize> = HashMap::with_capacity(self.patches.len());
         for (k, p) in self.patches.iter().enumerate() {
             let frame = frame_of(&p.link).ok_or_else(|| {
-                LayoutError::new(
-                    file,
-                    p.line,
-                    format!("patch {}", p.id),
-                    LayoutErrorKind::UnknownLink(p.link.clone()),
-                )
+                LayoutError::new(file, p.line, format!("patch {}", p.id), LayoutErrorKind::UnknownLink(p.link.clone()))
             })?;
             patch_index.insert(p.id, k);
             patches.push(ResolvedPatch {
@@ -464,10 +392,7 @@ impl SkinLayout {
 
 fn fmt_num(v: f64, decimals: usize) -> String {
     let s = format!("{v:.decimals$}");
-    if s.trim_start_matches('-')
-        .chars()
-        .all(|c| c == '0' || c == '.')
-    {
+    if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') {
         "0.0".to_string()
     } else {
         let t = s.trim_end_matches('0');
@@ -480,12 +405,7 @@ fn fmt_num(v: f64, decimals: usize) -> String {
 }
 
 fn fmt3(v: &[f64; 3], decimals: usize) -> String {
-    format!(
-        "[{}, {}, {}]",
-        fmt_num(v[0], decimals),
-        fmt_num(v[1], decimals),
-        fmt_num(v[2], decimals)
-    )
+    format!("[{}, {}, {}]", fmt_num(v[0], decimals), fmt_num(v[1], decimals), fmt_num(v[2], decimals))
 }
 
 #[cfg(test)]
@@ -530,11 +450,7 @@ cells:
             let u = Unit::new_normalize(n);
             let r = cell_rotation(&u);
             let m = r.matrix();
-            assert_relative_eq!(
-                m * m.transpose(),
-                nalgebra::Matrix3::identity(),
-                epsilon = 1e-12
-            );
+            assert_relative_eq!(m * m.transpose(), nalgebra::Matrix3::identity(), epsilon = 1e-12);
             assert_relative_eq!(m.determinant(), 1.0, epsilon = 1e-12);
             assert_relative_eq!(r * Vector3::z(), u.into_inner(), epsilon = 1e-12);
         }
@@ -563,16 +479,8 @@ cells:
         let c = &r.cells()[0];
         assert_relative_eq!(c.normal_patch, Vector3::x(), epsilon = 1e-12);
         assert_relative_eq!(c.normal_link, Vector3::y(), epsilon = 1e-12);
-        assert_relative_eq!(
-            c.position_link,
-            Vector3::new(0.0, 0.05, 0.1),
-            epsilon = 1e-12
-        );
-        assert_relative_eq!(
-            c.link_from_cell * Vector3::z(),
-            c.normal_link,
-            epsilon = 1e-12
-        );
+        assert_relative_eq!(c.position_link, Vector3::new(0.0, 0.05, 0.1), epsilon = 1e-12);
+        assert_relative_eq!(c.link_from_cell * Vector3::z(), c.normal_link, epsilon = 1e-12);
     }
 
     #[test]
@@ -584,61 +492,38 @@ cells:
         assert_eq!(back.patches.len(), 2);
         assert_eq!(back.cells.len(), 3);
         assert_eq!(back.cells[0].normal, [2.0, 0.0, 0.0]);
-        assert_relative_eq!(
-            back.patches[0].rpy[2],
-            std::f64::consts::FRAC_PI_2,
-            epsilon = 1e-6
-        );
+        assert_relative_eq!(back.patches[0].rpy[2], std::f64::consts::FRAC_PI_2, epsilon = 1e-6);
     }
 
     #[test]
     fn duplicate_cell_id() {
         let e = err(&GOOD.replace("id: 12", "id: 10"));
-        assert!(
-            e.contains("cfg/bad.yaml:8")
-                && e.contains("cell 10")
-                && e.contains("duplicate cell id"),
-            "{e}"
-        );
+        assert!(e.contains("cfg/bad.yaml:8") && e.contains("cell 10") && e.contains("duplicate cell id"), "{e}");
         assert!(e.contains("line 6"), "{e}");
     }
 
     #[test]
     fn duplicate_patch_id() {
         let e = err(&GOOD.replace("{id: 2, link", "{id: 1, link"));
-        assert!(
-            e.contains("cfg/bad.yaml:4")
-                && e.contains("patch 1")
-                && e.contains("duplicate patch id"),
-            "{e}"
-        );
+        assert!(e.contains("cfg/bad.yaml:4") && e.contains("patch 1") && e.contains("duplicate patch id"), "{e}");
     }
 
     #[test]
     fn unknown_patch() {
         let e = err(&GOOD.replace("{id: 11, patch: 2", "{id: 11, patch: 7"));
-        assert!(
-            e.contains("cfg/bad.yaml:7") && e.contains("cell 11") && e.contains("unknown patch 7"),
-            "{e}"
-        );
+        assert!(e.contains("cfg/bad.yaml:7") && e.contains("cell 11") && e.contains("unknown patch 7"), "{e}");
     }
 
     #[test]
     fn unknown_link() {
         let e = err(&GOOD.replace("link_b", "no_such_link"));
-        assert!(
-            e.contains("cfg/bad.yaml:4") && e.contains("patch 2") && e.contains("no_such_link"),
-            "{e}"
-        );
+        assert!(e.contains("cfg/bad.yaml:4") && e.contains("patch 2") && e.contains("no_such_link"), "{e}");
     }
 
     #[test]
     fn bad_normals() {
         let e = err(&GOOD.replace("normal: [0, 1, 0]", "normal: [0, 0, 0]"));
-        assert!(
-            e.contains("cfg/bad.yaml:7") && e.contains("cell 11") && e.contains("zero-length"),
-            "{e}"
-        );
+        assert!(e.contains("cfg/bad.yaml:7") && e.contains("cell 11") && e.contains("zero-length"), "{e}");
         let e = err(&GOOD.replace("normal: [0, 1, 0]", "normal: [0, .nan, 0]"));
         assert!(e.contains("cell 11") && e.contains("not finite"), "{e}");
     }
@@ -646,10 +531,7 @@ cells:
     #[test]
     fn empty_layouts() {
         let e = err("patches: []\ncells: []\n");
-        assert!(
-            e.contains("cfg/bad.yaml") && e.contains("no patches"),
-            "{e}"
-        );
+        assert!(e.contains("cfg/bad.yaml") && e.contains("no patches"), "{e}");
         let e = err("patches:\n  - {id: 1, link: link_a}\n");
         assert!(e.contains("cfg/bad.yaml") && e.contains("no cells"), "{e}");
     }
@@ -661,9 +543,7 @@ cells:
         let e = err(&GOOD.replace("normal: [0, 0, 1]}", "normal: [0, 0, 1], colour: red}"));
         assert!(e.starts_with("cfg/bad.yaml:"), "{e}");
         eprintln!("example parse error: {e}");
-        let e = SkinLayout::load(Path::new("does/not/exist.yaml"))
-            .unwrap_err()
-            .to_string();
+        let e = SkinLayout::load(Path::new("does/not/exist.yaml")).unwrap_err().to_string();
         assert!(e.contains("does/not/exist.yaml"), "{e}");
     }
 
@@ -678,9 +558,6 @@ cells:
         let text = e.to_string();
         assert_eq!(e.file, path.display().to_string());
         assert_eq!(e.line, Some(8));
-        assert!(
-            text.starts_with(&format!("{}:8: cell 11: duplicate cell id", path.display())),
-            "{text}"
-        );
+        assert!(text.starts_with(&format!("{}:8: cell 11: duplicate cell id", path.display())), "{text}");
     }
 }

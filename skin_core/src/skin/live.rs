@@ -6,12 +6,12 @@ use super::characteristic::{PreparedProximity, ProximityCharacteristic};
 use super::signals::CellReading;
 
 /// The non-silent cells of one cycle's readings ([`CellReading::is_silent`]) with their
-/// readings, in cell order. A silent cell adds nothing to a patch wrench (paper 003 eq. 6-8), an
-/// avoidance row (paper 000 eq. 3) or a contact row (eq. 6), and most cells of a skin are
+/// readings, in cell order. A silent cell adds nothing to a patch wrench (interactive-force-control paper eq. 6-8), an
+/// avoidance row (intentional-contact paper eq. 3) or a contact row (eq. 6), and most cells of a skin are
 /// silent: collected once per cycle, the aggregation and the skin tasks visit only these cells
 /// instead of scanning the whole skin each. With each cell its distance through the inverse
 /// proximity characteristic, computed once per cycle for the supervisor's summary and the
-/// avoidance task (paper 000 eq. 3). Storage is allocated once ([`LiveCells::with_capacity`]).
+/// avoidance task (intentional-contact paper eq. 3). Storage is allocated once ([`LiveCells::with_capacity`]).
 #[derive(Debug, Clone)]
 pub struct LiveCells {
     /// Number of readings collected from (one per layout cell).
@@ -26,7 +26,12 @@ impl LiveCells {
     /// Room for the readings of `cells` cells: [`LiveCells::collect`] on at most that many
     /// readings does not allocate. `proximity` turns the proximity signals into distances.
     pub fn with_capacity(cells: usize, proximity: &ProximityCharacteristic) -> Self {
-        Self { cells: 0, live: Vec::with_capacity(cells), distances: Vec::with_capacity(cells), proximity: proximity.prepared() }
+        Self {
+            cells: 0,
+            live: Vec::with_capacity(cells),
+            distances: Vec::with_capacity(cells),
+            proximity: proximity.prepared(),
+        }
     }
 
     /// The non-silent cells of `readings` (indexed like the layout's cells), in new storage.

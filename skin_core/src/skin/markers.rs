@@ -95,7 +95,17 @@ pub struct SkinMarker {
 
 impl SkinMarker {
     fn new(ns: &'static str, id: i32, action: MarkerAction, shape: MarkerShape) -> Self {
-        SkinMarker { ns, id, action, shape, frame: String::new(), scale: [0.0; 3], color: [1.0; 4], points: Vec::new(), colors: Vec::new() }
+        SkinMarker {
+            ns,
+            id,
+            action,
+            shape,
+            frame: String::new(),
+            scale: [0.0; 3],
+            color: [1.0; 4],
+            points: Vec::new(),
+            colors: Vec::new(),
+        }
     }
 
     /// A delete-all: clears every marker of the display.
@@ -121,7 +131,14 @@ impl SkinMarkers {
     /// Writes into `out` the updates that bring a viewer up to date with `readings` (indexed like
     /// `layout.cells()`) and `wrenches` (indexed like `layout.patches()`). `out` is empty when
     /// nothing changed in what is shown.
-    pub fn update(&mut self, layout: &ResolvedLayout, readings: &[CellReading], fusion: &FusionParams, wrenches: &[PatchWrench], out: &mut Vec<SkinMarker>) {
+    pub fn update(
+        &mut self,
+        layout: &ResolvedLayout,
+        readings: &[CellReading],
+        fusion: &FusionParams,
+        wrenches: &[PatchWrench],
+        out: &mut Vec<SkinMarker>,
+    ) {
         out.clear();
         if !self.cleared {
             out.push(SkinMarker::delete_all());
@@ -142,7 +159,13 @@ impl SkinMarkers {
     }
 }
 
-fn cells_marker(layout: &ResolvedLayout, patch: &ResolvedPatch, readings: &[CellReading], fusion: &FusionParams, id: i32) -> SkinMarker {
+fn cells_marker(
+    layout: &ResolvedLayout,
+    patch: &ResolvedPatch,
+    readings: &[CellReading],
+    fusion: &FusionParams,
+    id: i32,
+) -> SkinMarker {
     let mut m = SkinMarker::new(CELLS_NS, id, MarkerAction::Add, MarkerShape::SphereList);
     m.frame.clone_from(&patch.link);
     m.scale = [CELL_DIAMETER_M; 3];
@@ -174,7 +197,8 @@ mod tests {
     use crate::skin::layout::SkinLayout;
     use crate::skin::signals::ForceReduction;
 
-    const FUSION: FusionParams = FusionParams { weight_force: 0.5, activity_threshold: 0.02, force_reduction: ForceReduction::Mean };
+    const FUSION: FusionParams =
+        FusionParams { weight_force: 0.5, activity_threshold: 0.02, force_reduction: ForceReduction::Mean };
 
     fn layout() -> ResolvedLayout {
         let text = "patches:\n  - {id: 7, link: a, xyz: [0, 0, 1], rpy: [0, 0, 1.5707963267948966]}\n  \
@@ -203,7 +227,10 @@ mod tests {
         let actions: Vec<MarkerAction> = out.iter().map(|m| m.action).collect();
         assert_eq!(actions, [MarkerAction::DeleteAll, MarkerAction::Add, MarkerAction::Add]);
         let (cells, arrow) = (&out[1], &out[2]);
-        assert_eq!((cells.ns, cells.id, cells.frame.as_str(), cells.shape), (CELLS_NS, 0, "a", MarkerShape::SphereList));
+        assert_eq!(
+            (cells.ns, cells.id, cells.frame.as_str(), cells.shape),
+            (CELLS_NS, 0, "a", MarkerShape::SphereList)
+        );
         assert_eq!(cells.points.len(), 1);
         // Cell 10 at (0.1, 0, 0) in the patch frame, turned 90 degrees about z, 1 m up.
         let p = cells.points[0];

@@ -18,9 +18,9 @@ pub struct SkinParams {
     pub proximity: ProximityCharacteristic,
     /// Force characteristic (force <-> signal).
     pub force: ForceCharacteristic,
-    /// Fusion of force and proximity into the cells' virtual force (paper 003 eq. (6)).
+    /// Fusion of force and proximity into the cells' virtual force (interactive-force-control paper eq. (6)).
     pub fusion: FusionParams,
-    /// Repulsion from proximity (paper 000 eq. (3), paper 003 eq. (16)).
+    /// Repulsion from proximity (intentional-contact paper eq. (3), interactive-force-control paper eq. (16)).
     pub repulsion: RepulsionParams,
 }
 
@@ -86,7 +86,10 @@ mod tests {
         write("b.yaml", "extends: a.yaml\n");
         let e = ResolverParams::load(&dir.join("a.yaml")).unwrap_err().to_string();
         assert!(e.contains("a.yaml") && e.contains("extends") && e.contains("cycle"), "{e}");
-        write("c.yaml", &format!("extends: {}\narm: {{sync_gain_per_s: -1.0}}\n", config.join("resolver.yaml").display()));
+        write(
+            "c.yaml",
+            &format!("extends: {}\narm: {{sync_gain_per_s: -1.0}}\n", config.join("resolver.yaml").display()),
+        );
         let e = ResolverParams::load(&dir.join("c.yaml")).unwrap_err().to_string();
         assert!(e.contains("c.yaml") && e.contains("arm.sync_gain_per_s"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
@@ -96,17 +99,9 @@ mod tests {
     fn invalid_value_names_file_and_key() {
         let text = std::fs::read_to_string(shipped()).unwrap();
         let bad = text.replace("decay_m: 0.03", "decay_m: -0.03");
-        assert_ne!(
-            bad, text,
-            "test expects `decay_m: 0.03` in the shipped file"
-        );
-        let e = SkinParams::from_yaml_str(&bad, "bad.yaml")
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("bad.yaml") && e.contains("proximity.decay_m"),
-            "{e}"
-        );
+        assert_ne!(bad, text, "test expects `decay_m: 0.03` in the shipped file");
+        let e = SkinParams::from_yaml_str(&bad, "bad.yaml").unwrap_err().to_string();
+        assert!(e.contains("bad.yaml") && e.contains("proximity.decay_m"), "{e}");
     }
 
     #[test]

@@ -1,4 +1,4 @@
-//! Repulsive force laws: paper 000 eq. (3) (linear, per skin cell) and paper 003 eq. (16)
+//! Repulsive force laws: intentional-contact paper eq. (3) (linear, per skin cell) and interactive-force-control paper eq. (16)
 //! (exponential).
 
 use serde::{Deserialize, Serialize};
@@ -9,13 +9,13 @@ use crate::param_file::InvalidParam;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RepulsionParams {
-    /// `K` of paper 000 eq. (3) \[N/m\].
+    /// `K` of intentional-contact paper eq. (3) \[N/m\].
     pub gain_n_per_m: f64,
-    /// `d_range` of paper 000 eq. (3) \[m\]: no repulsion at or beyond it.
+    /// `d_range` of intentional-contact paper eq. (3) \[m\]: no repulsion at or beyond it.
     pub range_m: f64,
-    /// `f_max` of paper 003 eq. (16) \[N\]: the force at distance 0.
+    /// `f_max` of interactive-force-control paper eq. (16) \[N\]: the force at distance 0.
     pub max_force_n: f64,
-    /// `alpha` of paper 003 eq. (16) \[m\]: decay length.
+    /// `alpha` of interactive-force-control paper eq. (16) \[m\]: decay length.
     pub decay_m: f64,
 }
 
@@ -28,20 +28,20 @@ impl RepulsionParams {
         InvalidParam::positive_finite(prefix, "decay_m", self.decay_m)
     }
 
-    /// Paper 000 eq. (3) with these parameters, see [`linear_repulsion`].
+    /// Intentional-contact paper eq. (3) with these parameters, see [`linear_repulsion`].
     #[inline]
     pub fn linear_n(&self, distance_m: f64) -> f64 {
         linear_repulsion(self.gain_n_per_m, self.range_m, distance_m)
     }
 
-    /// Paper 003 eq. (16) with these parameters, see [`exponential_repulsion`].
+    /// Interactive-force-control paper eq. (16) with these parameters, see [`exponential_repulsion`].
     #[inline]
     pub fn exponential_n(&self, distance_m: f64) -> f64 {
         exponential_repulsion(self.max_force_n, self.decay_m, distance_m)
     }
 }
 
-/// Paper 000 eq. (3): repulsive force magnitude \[N\] `K (d_range - d)` for `d < d_range`, else 0.
+/// Intentional-contact paper eq. (3): repulsive force magnitude \[N\] `K (d_range - d)` for `d < d_range`, else 0.
 /// Negative distances count as 0 (contact); NaN gives 0 (nothing measured).
 #[inline]
 pub fn linear_repulsion(gain_n_per_m: f64, range_m: f64, distance_m: f64) -> f64 {
@@ -52,7 +52,7 @@ pub fn linear_repulsion(gain_n_per_m: f64, range_m: f64, distance_m: f64) -> f64
     }
 }
 
-/// Paper 003 eq. (16): `f_rep(d) = f_max exp(-d / alpha)` \[N\]. Negative distances count as 0
+/// Interactive-force-control paper eq. (16): `f_rep(d) = f_max exp(-d / alpha)` \[N\]. Negative distances count as 0
 /// (giving `f_max`); NaN and +Inf give 0.
 #[inline]
 pub fn exponential_repulsion(max_force_n: f64, decay_m: f64, distance_m: f64) -> f64 {
@@ -79,9 +79,7 @@ mod tests {
     #[test]
     fn exponential_law() {
         assert_eq!(exponential_repulsion(20.0, 0.05, 0.0), 20.0);
-        assert!(
-            (exponential_repulsion(20.0, 0.05, 0.05) - 20.0 / std::f64::consts::E).abs() < 1e-12
-        );
+        assert!((exponential_repulsion(20.0, 0.05, 0.05) - 20.0 / std::f64::consts::E).abs() < 1e-12);
         assert_eq!(exponential_repulsion(20.0, 0.05, f64::INFINITY), 0.0);
         assert_eq!(exponential_repulsion(20.0, 0.05, f64::NAN), 0.0);
         assert_eq!(exponential_repulsion(20.0, 0.05, -3.0), 20.0);

@@ -49,7 +49,7 @@ pub struct ResolvedCell {
 pub(crate) struct PatchCellGeometry {
     /// Unit outward normal `n_i` in the patch frame.
     pub(crate) normal: Vector3<f64>,
-    /// Lever `t_i × n_i` (paper 003 eq. (8) per unit virtual force).
+    /// Lever `t_i × n_i` (interactive-force-control paper eq. (8) per unit virtual force).
     pub(crate) lever: Vector3<f64>,
     /// Position `t_i` in the patch frame \[m\].
     pub(crate) position: Vector3<f64>,
@@ -117,11 +117,7 @@ pub struct ResolvedLayout {
 }
 
 impl ResolvedLayout {
-    pub(crate) fn new(
-        source: String,
-        patches: Vec<ResolvedPatch>,
-        cells: Vec<ResolvedCell>,
-    ) -> Self {
+    pub(crate) fn new(source: String, patches: Vec<ResolvedPatch>, cells: Vec<ResolvedCell>) -> Self {
         let ids = IdIndex::new(&cells);
         let patch_geometry = cells
             .iter()
@@ -133,20 +129,9 @@ impl ResolvedLayout {
             .collect();
         let link_geometry = cells
             .iter()
-            .map(|c| LinkCellGeometry {
-                frame: c.frame,
-                position: c.position_link,
-                normal: c.normal_link,
-            })
+            .map(|c| LinkCellGeometry { frame: c.frame, position: c.position_link, normal: c.normal_link })
             .collect();
-        ResolvedLayout {
-            source,
-            patches,
-            cells,
-            ids,
-            patch_geometry,
-            link_geometry,
-        }
+        ResolvedLayout { source, patches, cells, ids, patch_geometry, link_geometry }
     }
 
     /// Source file of the layout.

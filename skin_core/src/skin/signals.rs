@@ -18,7 +18,7 @@ pub enum ForceReduction {
 /// One cell's normalized readings, all nominally in [0, 1].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct CellReading {
-    /// The three capacitive force sensors of the cell (paper 003 Sec. 4.1.2).
+    /// The three capacitive force sensors of the cell (interactive-force-control paper Sec. 4.1.2).
     pub force: [f64; 3],
     /// The optical proximity sensor: 1 at contact, 0 when nothing is within range.
     pub proximity: f64,
@@ -27,10 +27,7 @@ pub struct CellReading {
 impl CellReading {
     /// A reading with all three force sensors at `force` and the given proximity.
     pub const fn uniform(force: f64, proximity: f64) -> Self {
-        CellReading {
-            force: [force; 3],
-            proximity,
-        }
+        CellReading { force: [force; 3], proximity }
     }
 
     /// The cell's force signal `f_{s_i}` in [0, 1]: each sensor sanitized
@@ -67,16 +64,11 @@ mod tests {
 
     #[test]
     fn reductions_and_sanitizing() {
-        let r = CellReading {
-            force: [0.3, f64::NAN, 1.5],
-            proximity: -0.2,
-        };
+        let r = CellReading { force: [0.3, f64::NAN, 1.5], proximity: -0.2 };
         assert!((r.force_signal(ForceReduction::Mean) - 1.3 / 3.0).abs() < 1e-15);
         assert_eq!(r.force_signal(ForceReduction::Max), 1.0);
         assert_eq!(r.proximity_signal(), 0.0);
         assert_eq!(CellReading::uniform(0.4, f64::NAN).proximity_signal(), 0.0);
-        assert!(
-            (CellReading::uniform(0.4, 0.0).force_signal(ForceReduction::Mean) - 0.4).abs() < 1e-15
-        );
+        assert!((CellReading::uniform(0.4, 0.0).force_signal(ForceReduction::Mean) - 0.4).abs() < 1e-15);
     }
 }

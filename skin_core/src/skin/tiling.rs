@@ -50,14 +50,7 @@ pub enum Face {
 
 impl Face {
     /// All six faces in the order +x, -x, +y, -y, +z, -z.
-    pub const ALL: [Face; 6] = [
-        Face::PosX,
-        Face::NegX,
-        Face::PosY,
-        Face::NegY,
-        Face::PosZ,
-        Face::NegZ,
-    ];
+    pub const ALL: [Face; 6] = [Face::PosX, Face::NegX, Face::PosY, Face::NegY, Face::PosZ, Face::NegZ];
 
     /// Outward unit normal, its axis index and sign.
     fn axis(self) -> (usize, f64) {
@@ -83,11 +76,7 @@ impl FromStr for Face {
             "-y" => Face::NegY,
             "+z" | "z" => Face::PosZ,
             "-z" => Face::NegZ,
-            other => {
-                return Err(format!(
-                    "unknown box face `{other}` (use +x, -x, +y, -y, +z, -z)"
-                ))
-            }
+            other => return Err(format!("unknown box face `{other}` (use +x, -x, +y, -y, +z, -z)")),
         })
     }
 }
@@ -97,11 +86,7 @@ impl FromStr for Face {
 pub fn centres_along(extent: f64, spacing: f64, pitch: f64) -> Vec<f64> {
     let usable = extent - pitch;
     if usable < 0.0 {
-        return if extent >= 0.75 * pitch {
-            vec![0.0]
-        } else {
-            Vec::new()
-        };
+        return if extent >= 0.75 * pitch { vec![0.0] } else { Vec::new() };
     }
     let n = (usable / spacing + 1e-9).floor() as usize + 1;
     let start = -((n - 1) as f64) * spacing / 2.0;
@@ -152,10 +137,7 @@ pub fn tile_cylinder(radius: f64, length: f64, pitch: f64) -> Vec<TiledCell> {
         for k in 0..n {
             let a = offset + k as f64 * step;
             let normal = Vector3::new(a.cos(), a.sin(), 0.0);
-            out.push(TiledCell {
-                position: Vector3::new(radius * normal.x, radius * normal.y, z),
-                normal,
-            });
+            out.push(TiledCell { position: Vector3::new(radius * normal.x, radius * normal.y, z), normal });
         }
     }
     out
@@ -175,10 +157,7 @@ pub fn tile_box(size: &Vector3<f64>, faces: &[Face], pitch: f64) -> Vec<TiledCel
             p[axis] = sign * size[axis] / 2.0;
             p[u] = a;
             p[v] = b;
-            out.push(TiledCell {
-                position: p,
-                normal,
-            });
+            out.push(TiledCell { position: p, normal });
         }
     }
     out
@@ -195,10 +174,7 @@ pub fn tile_sphere(radius: f64, pitch: f64) -> Vec<TiledCell> {
             let rho = (1.0 - z * z).max(0.0).sqrt();
             let phi = golden * i as f64;
             let normal = Vector3::new(rho * phi.cos(), rho * phi.sin(), z);
-            TiledCell {
-                position: normal * radius,
-                normal,
-            }
+            TiledCell { position: normal * radius, normal }
         })
         .collect()
 }

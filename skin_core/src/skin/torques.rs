@@ -1,5 +1,5 @@
-//! Joint torques `J^T F` of skin forces: per cell (paper 000 eq. (4), (6)) and per patch
-//! (paper 003 eq. (14)).
+//! Joint torques `J^T F` of skin forces: per cell (intentional-contact paper eq. (4), (6)) and per patch
+//! (interactive-force-control paper eq. (14)).
 //!
 //! Instead of building a 6×n Jacobian per force, each force is pushed down the chain of joints
 //! that support its link: for a revolute joint `j` with world axis `a_j` through `o_j`,
@@ -41,17 +41,12 @@ pub fn add_wrench_torques(
     }
 }
 
-/// Paper 000 eq. (4) / (6): `tau = sum_i J_v(p_i)^T F_i` over the point forces (linear part
+/// Intentional-contact paper eq. (4) / (6): `tau = sum_i J_v(p_i)^T F_i` over the point forces (linear part
 /// only). Overwrites `tau` (length `model.nv()`). No allocation.
 ///
 /// # Panics
 /// If `tau.len() != model.nv()`.
-pub fn point_forces_to_torques(
-    model: &RobotModel,
-    data: &ModelData,
-    forces: &[PointForce],
-    tau: &mut DVector<f64>,
-) {
+pub fn point_forces_to_torques(model: &RobotModel, data: &ModelData, forces: &[PointForce], tau: &mut DVector<f64>) {
     assert_eq!(tau.len(), model.nv(), "tau must have model.nv() entries");
     tau.fill(0.0);
     let zero = Vector3::zeros();
@@ -60,7 +55,7 @@ pub fn point_forces_to_torques(
     }
 }
 
-/// Paper 003 eq. (13)-(14): `tau = sum_j J_{p_j}^T w_W_{p_j}` over the patches `j` with
+/// Interactive-force-control paper eq. (13)-(14): `tau = sum_j J_{p_j}^T w_W_{p_j}` over the patches `j` with
 /// `include(j)`; each patch wrench ([`PatchWrench`], patch frame, moment about the patch origin)
 /// is rotated to world (eq. (13)) and applied at the patch origin. `frame_pose` is not needed:
 /// patch poses come from `data`. Overwrites `tau` (length `model.nv()`). No allocation.
@@ -78,10 +73,7 @@ pub fn patch_wrenches_to_torques(
     tau: &mut DVector<f64>,
 ) {
     assert_eq!(tau.len(), model.nv(), "tau must have model.nv() entries");
-    assert!(
-        wrenches.len() >= layout.patches().len(),
-        "one wrench per patch"
-    );
+    assert!(wrenches.len() >= layout.patches().len(), "one wrench per patch");
     tau.fill(0.0);
     for (j, (patch, w)) in layout.patches().iter().zip(wrenches).enumerate() {
         if !include(j) || w.active_cells == 0 {
@@ -90,14 +82,6 @@ pub fn patch_wrenches_to_torques(
         let pose: Isometry3<f64> = data.frame_pose(patch.frame) * patch.link_from_patch;
         let force = pose.rotation * w.force;
         let moment = pose.rotation * w.moment;
-        add_wrench_torques(
-            model,
-            data,
-            patch.frame,
-            &pose.translation.vector,
-            &force,
-            &moment,
-            tau,
-        );
+        add_wrench_torques(model, data, patch.frame, &pose.translation.vector, &force, &moment, tau);
     }
 }

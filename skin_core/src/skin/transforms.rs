@@ -1,4 +1,4 @@
-//! Moving patch wrenches between frames: patch world poses, paper 003 eq. (11) (patch forces
+//! Moving patch wrenches between frames: patch world poses, interactive-force-control paper eq. (11) (patch forces
 //! summed in a hand frame) and eq. (13) (patch wrench in world coordinates).
 
 use nalgebra::{Isometry3, Vector3};
@@ -33,17 +33,14 @@ pub fn patch_poses_world<'a>(
     }
 }
 
-/// Paper 003 eq. (13): the patch wrench rotated into world coordinates,
+/// Interactive-force-control paper eq. (13): the patch wrench rotated into world coordinates,
 /// `[w_R_p 0; 0 w_R_p] p_W`. The moment stays about the patch frame origin.
 #[inline]
 pub fn patch_wrench_world(world_from_patch: &Isometry3<f64>, wrench: &PatchWrench) -> Wrench {
-    Wrench {
-        force: world_from_patch.rotation * wrench.force,
-        moment: world_from_patch.rotation * wrench.moment,
-    }
+    Wrench { force: world_from_patch.rotation * wrench.force, moment: world_from_patch.rotation * wrench.moment }
 }
 
-/// Paper 003 eq. (11): `h_F = sum_j h_R_{p_j} p_j_F` over the patches `j` with
+/// Interactive-force-control paper eq. (11): `h_F = sum_j h_R_{p_j} p_j_F` over the patches `j` with
 /// `include(j)` true, with `h_R_p = w_R_h^T w_R_p`. `patch_poses` as from
 /// [`patch_poses_world`], `wrenches` as from [`super::aggregate::aggregate_patches`].
 pub fn sum_patch_forces_in_frame(
@@ -58,9 +55,7 @@ pub fn sum_patch_forces_in_frame(
             sum_world += pose.rotation * w.force;
         }
     }
-    world_from_hand
-        .rotation
-        .inverse_transform_vector(&sum_world)
+    world_from_hand.rotation.inverse_transform_vector(&sum_world)
 }
 
 #[cfg(test)]
@@ -105,10 +100,7 @@ mod tests {
         let mut poses = Vec::new();
         patch_poses_world(&l, |f| &frames[f], |_| true, &mut poses);
         assert_relative_eq!(poses[0].translation.vector, Vector3::new(0.3, 0.0, 0.0));
-        let w = |x: f64, y: f64, z: f64| PatchWrench {
-            force: Vector3::new(x, y, z),
-            ..Default::default()
-        };
+        let w = |x: f64, y: f64, z: f64| PatchWrench { force: Vector3::new(x, y, z), ..Default::default() };
         let wrenches = [w(1.0, 0.0, 0.0), w(0.0, 1.0, 0.0), w(0.0, 0.0, 7.0)];
         // Patch 1: Rz(90) x -> world y. Patch 2: Rx(90) y -> world z. Patch 3 excluded.
         // Hand frame = Rz(90): world (0, 1, 1) -> hand (1, 0, 1).

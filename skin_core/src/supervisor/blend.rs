@@ -1,7 +1,7 @@
-//! Smooth switching: the torque blend of paper 000 eq. (10)-(11), with a corrected χ, and the
-//! sigmoid fusion-weight shift of paper 003 Sec. 4.2.2.
+//! Smooth switching: the torque blend of intentional-contact paper eq. (10)-(11), with a corrected χ, and the
+//! sigmoid fusion-weight shift of interactive-force-control paper Sec. 4.2.2.
 //!
-//! Paper 000 eq. (11), `χ = (1 − tanh(δ_t (t − t_t)))/2`, gives `χ(t_t) = 1/2`: at the switch
+//! Intentional-contact paper eq. (11), `χ = (1 − tanh(δ_t (t − t_t)))/2`, gives `χ(t_t) = 1/2`: at the switch
 //! instant the output jumps from `τ_{k-1}` to `(τ_{k-1} + τ_k)/2`, a step of half the torque
 //! difference, which is what the blend is meant to avoid. We use
 //!
@@ -22,7 +22,7 @@
 //! ([`step_bound`]): the blend adds at most `δ_t dt` times the torque gap per cycle to the change
 //! the new arrangement itself makes.
 
-/// `χ` of the corrected paper 000 eq. (11) at `elapsed_s = t − t_t`: 1 for `elapsed ≤ 0`
+/// `χ` of the corrected intentional-contact paper eq. (11) at `elapsed_s = t − t_t`: 1 for `elapsed ≤ 0`
 /// (and NaN), then `1 − tanh(δ_t elapsed)`.
 pub fn chi(smoothing_gain_per_s: f64, elapsed_s: f64) -> f64 {
     if elapsed_s > 0.0 {
@@ -38,7 +38,7 @@ pub fn step_bound(smoothing_gain_per_s: f64, dt_s: f64, gap_norm: f64, dtau_k_no
     dtau_k_norm + smoothing_gain_per_s * dt_s * gap_norm
 }
 
-/// Paper 000 eq. (10): `τ = χ τ_{k-1} + (1 − χ) τ_k`, with `τ_{k-1}` the output torque held at
+/// Intentional-contact paper eq. (10): `τ = χ τ_{k-1} + (1 − χ) τ_k`, with `τ_{k-1}` the output torque held at
 /// the switch. Storage is allocated once in [`TorqueBlender::new`].
 #[derive(Debug, Clone)]
 pub struct TorqueBlender {
@@ -111,11 +111,7 @@ impl TorqueBlender {
     pub fn apply(&mut self, t_s: f64, tau_k: &[f64], out: &mut [f64]) {
         assert_eq!(tau_k.len(), self.last.len(), "tau_k length");
         assert_eq!(out.len(), self.last.len(), "out length");
-        let c = if self.blending {
-            chi(self.gain_per_s, t_s - self.switch_time_s)
-        } else {
-            0.0
-        };
+        let c = if self.blending { chi(self.gain_per_s, t_s - self.switch_time_s) } else { 0.0 };
         if c <= f64::EPSILON {
             // Below one ulp of the held torque's weight the blend is over (snapping adds at
             // most EPSILON times the gap to one cycle's change).
@@ -131,7 +127,7 @@ impl TorqueBlender {
     }
 }
 
-/// The paper 003 fusion weight shift: `w(t) = w_0 + (w_1 − w_0) s((t − t_t)/T)` with `s` a
+/// The interactive-force-control paper fusion weight shift: `w(t) = w_0 + (w_1 − w_0) s((t − t_t)/T)` with `s` a
 /// logistic of steepness `gain` over `[0, 1]`, rescaled so that `s(0) = 0` and `s(1) = 1`
 /// exactly (no step at either end) and monotonic in between.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -146,24 +142,12 @@ pub struct WeightShift {
 impl WeightShift {
     /// A weight resting at `w`.
     pub fn constant(w: f64) -> Self {
-        WeightShift {
-            from: w,
-            to: w,
-            start_s: 0.0,
-            duration_s: 1.0,
-            gain: 1.0,
-        }
+        WeightShift { from: w, to: w, start_s: 0.0, duration_s: 1.0, gain: 1.0 }
     }
 
     /// A shift from `from` to `to` starting at `start_s`, lasting `duration_s > 0`.
     pub fn new(from: f64, to: f64, start_s: f64, duration_s: f64, gain: f64) -> Self {
-        WeightShift {
-            from,
-            to,
-            start_s,
-            duration_s,
-            gain,
-        }
+        WeightShift { from, to, start_s, duration_s, gain }
     }
 
     /// The target weight.

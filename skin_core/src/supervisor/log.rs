@@ -16,12 +16,7 @@ impl TransitionLog {
     /// An empty log holding up to `capacity` (≥ 1) transitions.
     pub fn new(capacity: usize) -> Self {
         let capacity = capacity.max(1);
-        TransitionLog {
-            buf: Vec::with_capacity(capacity),
-            capacity,
-            next: 0,
-            total: 0,
-        }
+        TransitionLog { buf: Vec::with_capacity(capacity), capacity, next: 0, total: 0 }
     }
 
     /// Records a transition.
@@ -42,11 +37,7 @@ impl TransitionLog {
 
     /// The kept transitions, oldest first.
     pub fn iter(&self) -> impl Iterator<Item = &Transition> + '_ {
-        let split = if self.buf.len() < self.capacity {
-            0
-        } else {
-            self.next
-        };
+        let split = if self.buf.len() < self.capacity { 0 } else { self.next };
         self.buf[split..].iter().chain(self.buf[..split].iter())
     }
 

@@ -1,11 +1,9 @@
-//! The supervisor state machine: paper 000 Table I switched on sensed conditions, or the paper
+//! The supervisor state machine: intentional-contact paper Table I switched on sensed conditions, or the paper
 //! 003 Table 1 phases switched on request. The exact rules are in `docs/supervisor.md`.
 
 use super::blend::WeightShift;
 use super::log::TransitionLog;
-use super::params::{
-    DwellTimes, FusionShift, ParamError, Policy, SensingRange, SupervisorParams, Thresholds,
-};
+use super::params::{DwellTimes, FusionShift, ParamError, Policy, SensingRange, SupervisorParams, Thresholds};
 use super::types::{Arrangement, Cause, Imposed, Mode, Phase, PhaseRefused, SupervisorInput, Transition};
 
 /// A condition that must hold for a dwell time, with a hysteresis between the condition that
@@ -89,7 +87,7 @@ pub struct Supervisor {
 
 impl Supervisor {
     /// A supervisor at time `t0_s` in the initial mode of the policy: (a) avoidance for paper
-    /// 000, precontact for paper 003. `t0_s` is the initial switch time.
+    /// 000, precontact for interactive-force-control paper. `t0_s` is the initial switch time.
     pub fn new(params: &SupervisorParams, t0_s: f64) -> Result<Self, ParamError> {
         params.validate()?;
         let orders = params.task_indices()?;
@@ -164,8 +162,8 @@ impl Supervisor {
         &self.arrangement
     }
 
-    /// Requests a paper 003 phase; it takes effect at the next [`Self::update`] (whose time is
-    /// the switch time). Refused under the paper 000 policy, which switches on sensed
+    /// Requests a interactive-force-control paper phase; it takes effect at the next [`Self::update`] (whose time is
+    /// the switch time). Refused under the intentional-contact paper policy, which switches on sensed
     /// conditions only. Requesting the active phase is accepted and changes nothing.
     pub fn request_phase(&mut self, phase: Phase) -> Result<(), PhaseRefused> {
         match self.policy {
@@ -174,7 +172,7 @@ impl Supervisor {
                 Ok(())
             }
             Policy::IntentionalContact => Err(PhaseRefused {
-                reason: "the intentional_contact policy (paper 000 Table I) switches on sensed \
+                reason: "the intentional_contact policy (intentional-contact paper Table I) switches on sensed \
                          conditions only; configure `policy: phases` to request phases",
             }),
         }
@@ -207,7 +205,13 @@ impl Supervisor {
         let new_switch = a.mode != current.mode || a.switch_time_s.to_bits() != current.switch_time_s.to_bits();
         if a.fusion_weight_target != self.weight.target() {
             let now = self.weight.at(t);
-            self.weight = WeightShift::new(now, a.fusion_weight_target, a.switch_time_s, self.fusion.duration_s, self.fusion.gain);
+            self.weight = WeightShift::new(
+                now,
+                a.fusion_weight_target,
+                a.switch_time_s,
+                self.fusion.duration_s,
+                self.fusion.gain,
+            );
             self.arrangement.fusion_weight_target = a.fusion_weight_target;
         }
         if new_switch {
@@ -246,7 +250,7 @@ impl Supervisor {
         &self.log
     }
 
-    /// Paper 000 Table I with dwell times and hysteresis (rules in `docs/supervisor.md`).
+    /// Intentional-contact paper Table I with dwell times and hysteresis (rules in `docs/supervisor.md`).
     fn step_table_i(&mut self, t: f64, u: &SupervisorInput) {
         let th = self.thresholds;
         let dw = self.dwell;
@@ -284,9 +288,7 @@ impl Supervisor {
                     // (b) again (a cycle seen in the TOMM scenes).
                     let reached = ge <= th.goal_tolerance_m && clear;
                     // Every timer advances every cycle; then the first that has held wins.
-                    let g = self
-                        .goal_reached
-                        .step(t, reached, reached, dw.goal_reached_s);
+                    let g = self.goal_reached.step(t, reached, reached, dw.goal_reached_s);
                     let c = self.cleared.step(t, clear, clear, dw.clear_s);
                     let i = self.invalid.step(t, invalid, invalid, dw.clear_s);
                     let cause = if g {
@@ -313,7 +315,7 @@ impl Supervisor {
         }
     }
 
-    /// Paper 003 Table 1: a pending request switches the phase and starts the weight shift
+    /// Interactive-force-control paper Table 1: a pending request switches the phase and starts the weight shift
     /// from the current `w` (so a reversal mid-shift is continuous too).
     fn step_phases(&mut self, t: f64) {
         let Some(phase) = self.pending.take() else {
@@ -333,8 +335,8 @@ impl Supervisor {
         self.switch(t, to, Cause::PhaseRequest);
     }
 
-    /// Sensing range ramp (paper 000 Sec. III: reduced gradually during intentional contact):
-    /// toward `intentional_contact_m` in (b), back to nominal in (a) and the paper 003 phases,
+    /// Sensing range ramp (intentional-contact paper Sec. III: reduced gradually during intentional contact):
+    /// toward `intentional_contact_m` in (b), back to nominal in (a) and the interactive-force-control paper phases,
     /// held in (c).
     fn ramp_range(&mut self, dt: f64) {
         let target = match self.arrangement.mode {
@@ -368,12 +370,7 @@ impl Supervisor {
             *d = Dwell::IDLE;
         }
         self.progress = Progress::IDLE;
-        let tr = Transition {
-            t_s: t,
-            from,
-            to,
-            cause,
-        };
+        let tr = Transition { t_s: t, from, to, cause };
         self.last_transition = Some(tr);
         self.log.push(tr);
     }

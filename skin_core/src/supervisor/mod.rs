@@ -1,16 +1,16 @@
-//! The priority supervisor: paper 000 Table I arrangements and paper 003 Table 1 phases, with smooth switching.
+//! The priority supervisor: intentional-contact paper Table I arrangements and interactive-force-control paper Table 1 phases, with smooth switching.
 //!
 //! An arrangement is data: an ordered list of task names from `config/supervisor.yaml`
 //! ([`SupervisorParams`]), resolved once to indices into the configured task list. The
 //! [`Supervisor`] picks the active one each control cycle:
-//! - policy `intentional_contact` (paper 000 Table I): (a) avoidance > goal > contact reaction,
+//! - policy `intentional_contact` (intentional-contact paper Table I): (a) avoidance > goal > contact reaction,
 //!   (b) goal > contact reaction > avoidance (intentional contact, entered when stuck; the
-//!   sensing range ramps down, paper 000 Sec. III), (c) contact reaction > goal > avoidance
+//!   sensing range ramps down, intentional-contact paper Sec. III), (c) contact reaction > goal > avoidance
 //!   (hard contact, `‖F_c‖ ≥ ε_c`), with dwell times and hysteresis bands against chattering;
-//! - policy `phases` (paper 003 Table 1): precontact / contact on request, with the sigmoid
-//!   shift of the fusion weight `w` (paper 003 eq. (6), Sec. 4.2.2).
+//! - policy `phases` (interactive-force-control paper Table 1): precontact / contact on request, with the sigmoid
+//!   shift of the fusion weight `w` (interactive-force-control paper eq. (6), Sec. 4.2.2).
 //!
-//! [`TorqueBlender`] blends the torques of the old and new arrangements after a switch (paper 000
+//! [`TorqueBlender`] blends the torques of the old and new arrangements after a switch (intentional-contact paper
 //! eq. (10)-(11), with `χ(t_t) = 1` so there is no step; see [`blend`]). Nothing allocates after
 //! construction. Rules, values and the blend bound: `docs/supervisor.md`.
 //!

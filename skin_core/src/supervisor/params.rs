@@ -8,34 +8,34 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::param_file::InvalidParam;
 use crate::param_file::yaml::{self, YamlError};
+use crate::param_file::InvalidParam;
 
 /// Which switching policy the supervisor runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Policy {
-    /// Paper 000 Table I: avoidance / intentional contact / hard contact, switched on sensed
+    /// Intentional-contact paper Table I: avoidance / intentional contact / hard contact, switched on sensed
     /// conditions.
     IntentionalContact,
-    /// Paper 003 Table 1: precontact / contact, switched on request (paper 003 Sec. 4.2.2).
+    /// Interactive-force-control paper Table 1: precontact / contact, switched on request (interactive-force-control paper Sec. 4.2.2).
     Phases,
 }
 
 /// The five arrangements, each an ordered list of task names, highest priority first
-/// (paper 000 Table I (a)-(c), paper 003 Table 1). All five are required whatever the policy.
+/// (intentional-contact paper Table I (a)-(c), interactive-force-control paper Table 1). All five are required whatever the policy.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ArrangementNames {
-    /// Paper 000 Table I (a): avoidance > goal > contact reaction.
+    /// Intentional-contact paper Table I (a): avoidance > goal > contact reaction.
     pub avoidance: Vec<String>,
-    /// Paper 000 Table I (b): goal > contact reaction > avoidance.
+    /// Intentional-contact paper Table I (b): goal > contact reaction > avoidance.
     pub intentional_contact: Vec<String>,
-    /// Paper 000 Table I (c): contact reaction > goal > avoidance.
+    /// Intentional-contact paper Table I (c): contact reaction > goal > avoidance.
     pub hard_contact: Vec<String>,
-    /// Paper 003 Table 1, precontact phase.
+    /// Interactive-force-control paper Table 1, precontact phase.
     pub precontact: Vec<String>,
-    /// Paper 003 Table 1, contact phase.
+    /// Interactive-force-control paper Table 1, contact phase.
     pub contact: Vec<String>,
 }
 
@@ -52,7 +52,7 @@ impl ArrangementNames {
     }
 }
 
-/// Switching thresholds of paper 000 Table I and their hysteresis bands (SI units).
+/// Switching thresholds of intentional-contact paper Table I and their hysteresis bands (SI units).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Thresholds {
@@ -96,12 +96,12 @@ pub struct DwellTimes {
     pub clear_s: f64,
 }
 
-/// The proximity sensing range `d_range` of paper 000 eq. (3) and its ramp (paper 000 Sec. III:
+/// The proximity sensing range `d_range` of intentional-contact paper eq. (3) and its ramp (intentional-contact paper Sec. III:
 /// reduced during intentional contact, gradually down to the configured value).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SensingRange {
-    /// [m] range in (a) and in the paper 003 phases, `> 0`.
+    /// [m] range in (a) and in the interactive-force-control paper phases, `> 0`.
     pub nominal_m: f64,
     /// [m] range reached during intentional contact (b), in `[0, nominal_m]` (paper: 0).
     pub intentional_contact_m: f64,
@@ -111,12 +111,12 @@ pub struct SensingRange {
     pub restore_rate_mps: f64,
 }
 
-/// Paper 003 eq. (6) fusion weight `w` (0: proximity only, 1: force only) and its sigmoid shift
-/// on a phase switch (paper 003 Sec. 4.2.2).
+/// Interactive-force-control paper eq. (6) fusion weight `w` (0: proximity only, 1: force only) and its sigmoid shift
+/// on a phase switch (interactive-force-control paper Sec. 4.2.2).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FusionShift {
-    /// `w` in the precontact phase (and under the paper 000 policy), in `[0, 1]`.
+    /// `w` in the precontact phase (and under the intentional-contact paper policy), in `[0, 1]`.
     pub w_precontact: f64,
     /// `w` in the contact phase, in `[0, 1]`.
     pub w_contact: f64,
@@ -142,9 +142,9 @@ pub struct SupervisorParams {
     pub dwell: DwellTimes,
     /// Sensing range and its ramp.
     pub sensing_range: SensingRange,
-    /// δ_t of paper 000 eq. (11) [1/s], `> 0`.
+    /// δ_t of intentional-contact paper eq. (11) [1/s], `> 0`.
     pub smoothing_gain_per_s: f64,
-    /// Fusion weight shift (paper 003).
+    /// Fusion weight shift (interactive-force-control paper).
     pub fusion: FusionShift,
     /// Capacity of the transition log ring buffer, in [1, 100000].
     pub log_capacity: usize,
@@ -262,14 +262,7 @@ impl SupervisorParams {
 
         let f = &self.fusion;
         let p = "fusion.";
-        InvalidParam::in_range(
-            p,
-            "w_precontact",
-            f.w_precontact,
-            0.0,
-            1.0,
-            "must be in [0, 1]",
-        )?;
+        InvalidParam::in_range(p, "w_precontact", f.w_precontact, 0.0, 1.0, "must be in [0, 1]")?;
         InvalidParam::in_range(p, "w_contact", f.w_contact, 0.0, 1.0, "must be in [0, 1]")?;
         InvalidParam::positive_finite(p, "gain", f.gain)?;
         InvalidParam::positive_finite(p, "duration_s", f.duration_s)?;
@@ -288,38 +281,27 @@ impl SupervisorParams {
     /// The five arrangements resolved to indices into [`Self::tasks`], in [`super::Mode`] order.
     pub fn task_indices(&self) -> Result<[Vec<usize>; 5], ParamError> {
         if self.tasks.is_empty() {
-            return Err(ParamError::Empty {
-                key: "tasks".into(),
-            });
+            return Err(ParamError::Empty { key: "tasks".into() });
         }
         for (i, name) in self.tasks.iter().enumerate() {
             if self.tasks[..i].contains(name) {
-                return Err(ParamError::DuplicateTask {
-                    key: format!("tasks[{i}]"),
-                    name: name.clone(),
-                });
+                return Err(ParamError::DuplicateTask { key: format!("tasks[{i}]"), name: name.clone() });
             }
         }
         let mut out: [Vec<usize>; 5] = Default::default();
         for (slot, (key, names)) in out.iter_mut().zip(self.arrangements.by_mode()) {
             if names.is_empty() {
-                return Err(ParamError::Empty {
-                    key: format!("arrangements.{key}"),
-                });
+                return Err(ParamError::Empty { key: format!("arrangements.{key}") });
             }
             for (i, name) in names.iter().enumerate() {
                 let key = || format!("arrangements.{key}[{i}]");
-                let idx = self.tasks.iter().position(|t| t == name).ok_or_else(|| {
-                    ParamError::UnknownTask {
-                        key: key(),
-                        name: name.clone(),
-                    }
-                })?;
+                let idx = self
+                    .tasks
+                    .iter()
+                    .position(|t| t == name)
+                    .ok_or_else(|| ParamError::UnknownTask { key: key(), name: name.clone() })?;
                 if slot.contains(&idx) {
-                    return Err(ParamError::DuplicateTask {
-                        key: key(),
-                        name: name.clone(),
-                    });
+                    return Err(ParamError::DuplicateTask { key: key(), name: name.clone() });
                 }
                 slot.push(idx);
             }
@@ -330,11 +312,7 @@ impl SupervisorParams {
     /// Parses and validates YAML text; `source` names the file in errors.
     pub fn from_yaml_str(text: &str, source: &str) -> Result<Self, SupervisorParamsError> {
         let p: SupervisorParams = yaml::parse_str(text, source)?;
-        p.validate()
-            .map_err(|error| SupervisorParamsError::Invalid {
-                file: source.to_string(),
-                error,
-            })?;
+        p.validate().map_err(|error| SupervisorParamsError::Invalid { file: source.to_string(), error })?;
         Ok(p)
     }
 

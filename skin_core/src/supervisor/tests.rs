@@ -33,12 +33,7 @@ impl Rng {
 }
 
 fn input(v: f64, fd: f64, fc: f64, ge: f64) -> SupervisorInput {
-    SupervisorInput {
-        ee_speed_mps: v,
-        avoidance_force_n: fd,
-        contact_force_n: fc,
-        goal_error_m: ge,
-    }
+    SupervisorInput { ee_speed_mps: v, avoidance_force_n: fd, contact_force_n: fc, goal_error_m: ge }
 }
 
 /// Runs `steps` cycles of `u` from `*t`; returns the transitions seen.
@@ -56,7 +51,7 @@ fn stuck() -> SupervisorInput {
     input(0.0, 3.0, 0.0, 0.2)
 }
 
-/// Drives the paper 000 supervisor into (b).
+/// Drives the intentional-contact paper supervisor into (b).
 /// A supervisor of `p` driven from (a) into (b), and the time it got there.
 fn in_b(p: &SupervisorParams) -> (Supervisor, f64) {
     let mut sup = Supervisor::new(p, 0.0).unwrap();
@@ -92,16 +87,9 @@ fn stuck_switches_a_to_b_after_dwell() {
     let mut t = 0.0;
     let tr = run(&mut sup, &mut t, 200, stuck());
     assert_eq!(tr.len(), 1);
-    assert_eq!(
-        (tr[0].from, tr[0].to, tr[0].cause),
-        (Mode::Avoidance, Mode::IntentionalContact, Cause::Stuck)
-    );
+    assert_eq!((tr[0].from, tr[0].to, tr[0].cause), (Mode::Avoidance, Mode::IntentionalContact, Cause::Stuck));
     // First sample at DT starts the dwell; the switch comes once stuck_s has elapsed.
-    assert!(
-        (tr[0].t_s - DT - p.dwell.stuck_s).abs() < DT + 1e-9,
-        "{}",
-        tr[0].t_s
-    );
+    assert!((tr[0].t_s - DT - p.dwell.stuck_s).abs() < DT + 1e-9, "{}", tr[0].t_s);
     assert_eq!(sup.arrangement().switch_time_s, tr[0].t_s);
     let names: Vec<&str> = sup.arrangement().task_names(sup.tasks()).collect();
     assert_eq!(names, ["goal", "contact_reaction", "avoidance"]);
@@ -132,10 +120,7 @@ fn contact_over_limit_b_to_c_and_release_back_to_b() {
     let (mut sup, mut t) = in_b(&p);
     let tr = run(&mut sup, &mut t, 10, input(0.0, 0.0, 6.0, 0.2));
     assert_eq!(tr.len(), 1);
-    assert_eq!(
-        (tr[0].from, tr[0].to),
-        (Mode::IntentionalContact, Mode::HardContact)
-    );
+    assert_eq!((tr[0].from, tr[0].to), (Mode::IntentionalContact, Mode::HardContact));
     assert_eq!(tr[0].cause, Cause::ContactOverLimit);
     let names: Vec<&str> = sup.arrangement().task_names(sup.tasks()).collect();
     assert_eq!(names, ["contact_reaction", "goal", "avoidance"]);
@@ -146,11 +131,7 @@ fn contact_over_limit_b_to_c_and_release_back_to_b() {
     assert_eq!(tr.len(), 1);
     assert_eq!(
         (tr[0].from, tr[0].to, tr[0].cause),
-        (
-            Mode::HardContact,
-            Mode::IntentionalContact,
-            Cause::ContactReleased
-        )
+        (Mode::HardContact, Mode::IntentionalContact, Cause::ContactReleased)
     );
 }
 
@@ -176,10 +157,7 @@ fn goal_reached_or_cleared_b_to_a() {
         let (mut sup, mut t) = in_b(&p);
         let tr = run(&mut sup, &mut t, 300, u);
         assert_eq!(tr.len(), 1, "{u:?}");
-        assert_eq!(
-            (tr[0].from, tr[0].to, tr[0].cause),
-            (Mode::IntentionalContact, Mode::Avoidance, cause)
-        );
+        assert_eq!((tr[0].from, tr[0].to, tr[0].cause), (Mode::IntentionalContact, Mode::Avoidance, cause));
     }
 }
 
@@ -207,10 +185,7 @@ fn sensing_range_shrinks_gradually_in_b_and_is_restored_in_a() {
         t += DT;
         let a = sup.update(t, &stuck());
         let d = prev - a.sensing_range_m;
-        assert!(
-            (-1e-15..=r.shrink_rate_mps * DT + 1e-12).contains(&d),
-            "step {d}"
-        );
+        assert!((-1e-15..=r.shrink_rate_mps * DT + 1e-12).contains(&d), "step {d}");
         prev = a.sensing_range_m;
         if prev == r.intentional_contact_m && hit_zero_at.is_none() {
             hit_zero_at = Some(t);
@@ -309,11 +284,7 @@ fn nan_contact_counts_as_over_limit_and_blocks_release() {
 #[test]
 fn nan_speed_or_goal_never_counts_as_stuck() {
     let p = params();
-    for u in [
-        input(f64::NAN, 3.0, 0.0, 0.2),
-        input(0.0, f64::NAN, 0.0, 0.2),
-        input(0.0, 3.0, 0.0, f64::NAN),
-    ] {
+    for u in [input(f64::NAN, 3.0, 0.0, 0.2), input(0.0, f64::NAN, 0.0, 0.2), input(0.0, 3.0, 0.0, f64::NAN)] {
         let mut sup = Supervisor::new(&p, 0.0).unwrap();
         let mut t = 0.0;
         assert!(run(&mut sup, &mut t, 1000, u).is_empty(), "{u:?}");
@@ -348,16 +319,7 @@ fn phases_switch_on_request_and_weight_follows_sigmoid() {
     let mut sup = Supervisor::new(&p, 0.0).unwrap();
     assert_eq!(sup.mode(), Mode::PreContact);
     let names: Vec<&str> = sup.arrangement().task_names(sup.tasks()).collect();
-    assert_eq!(
-        names,
-        [
-            "hand_distance",
-            "wrist",
-            "tactile_guidance",
-            "base_avoidance",
-            "posture"
-        ]
-    );
+    assert_eq!(names, ["hand_distance", "wrist", "tactile_guidance", "base_avoidance", "posture"]);
     let u = SupervisorInput::default();
     let mut t = 0.0;
     // No switch without a request, whatever the sensed signals.
@@ -366,24 +328,11 @@ fn phases_switch_on_request_and_weight_follows_sigmoid() {
     t += DT;
     sup.update(t, &u);
     let tr = sup.last_transition().unwrap();
-    assert_eq!(
-        (tr.from, tr.to, tr.cause),
-        (Mode::PreContact, Mode::Contact, Cause::PhaseRequest)
-    );
+    assert_eq!((tr.from, tr.to, tr.cause), (Mode::PreContact, Mode::Contact, Cause::PhaseRequest));
     assert_eq!(sup.arrangement().fusion_weight, f.w_precontact);
     assert_eq!(sup.arrangement().fusion_weight_target, f.w_contact);
     let names: Vec<&str> = sup.arrangement().task_names(sup.tasks()).collect();
-    assert_eq!(
-        names,
-        [
-            "hand_force",
-            "wrist",
-            "position_hold",
-            "base_avoidance",
-            "compliance",
-            "posture"
-        ]
-    );
+    assert_eq!(names, ["hand_force", "wrist", "position_hold", "base_avoidance", "compliance", "posture"]);
     let mut prev = sup.arrangement().fusion_weight;
     let mut max_step: f64 = 0.0;
     let steps = (f.duration_s / DT) as usize + 10;
@@ -448,13 +397,7 @@ fn log_ring_buffer_keeps_latest() {
     run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2)); // c -> b
     assert_eq!(sup.log().total(), 3);
     let kept: Vec<(Mode, Mode)> = sup.log().iter().map(|t| (t.from, t.to)).collect();
-    assert_eq!(
-        kept,
-        [
-            (Mode::IntentionalContact, Mode::HardContact),
-            (Mode::HardContact, Mode::IntentionalContact)
-        ]
-    );
+    assert_eq!(kept, [(Mode::IntentionalContact, Mode::HardContact), (Mode::HardContact, Mode::IntentionalContact)]);
     assert_eq!(sup.log().last().unwrap().to, Mode::IntentionalContact);
 }
 
@@ -515,21 +458,14 @@ fn blend_has_no_step_and_respects_per_cycle_bound() {
             blender.apply(t, &tau_k, &mut out);
             if step == 0 {
                 for i in 0..n {
-                    assert!(
-                        (out[i] - before[i]).abs() <= 1e-12,
-                        "step at switch, trial {trial}"
-                    );
+                    assert!((out[i] - before[i]).abs() <= 1e-12, "step at switch, trial {trial}");
                 }
             } else {
                 let d: Vec<f64> = out.iter().zip(&prev).map(|(a, b)| a - b).collect();
                 let dk: Vec<f64> = tau_k.iter().zip(&prev_k).map(|(a, b)| a - b).collect();
                 let gap: Vec<f64> = before.iter().zip(&prev_k).map(|(a, b)| a - b).collect();
                 let bound = step_bound(g, dt, norm(&gap), norm(&dk));
-                assert!(
-                    norm(&d) <= bound * (1.0 + 1e-12) + 1e-12,
-                    "trial {trial} step {step}: {} > {bound}",
-                    norm(&d)
-                );
+                assert!(norm(&d) <= bound * (1.0 + 1e-12) + 1e-12, "trial {trial} step {step}: {} > {bound}", norm(&d));
             }
             prev.copy_from_slice(&out);
         }
@@ -549,18 +485,11 @@ fn blend_syncs_with_arrangement_switch_time() {
         t += DT;
         let a = sup.update(t, &stuck());
         blender.sync(a);
-        let tau = if a.mode == Mode::Avoidance {
-            [1.0, 2.0]
-        } else {
-            [-1.0, 0.0]
-        };
+        let tau = if a.mode == Mode::Avoidance { [1.0, 2.0] } else { [-1.0, 0.0] };
         let last = out;
         blender.apply(t, &tau, &mut out);
         if sup.last_transition().is_some() {
-            assert_eq!(
-                out, last,
-                "first output after the switch is the held torque"
-            );
+            assert_eq!(out, last, "first output after the switch is the held torque");
             assert!(blender.is_blending());
         }
     }
@@ -592,35 +521,23 @@ fn load_err(old: &str, new: &str) -> String {
     let text = shipped_text();
     let bad = text.replace(old, new);
     assert_ne!(bad, text, "test expects `{old}` in the shipped file");
-    SupervisorParams::from_yaml_str(&bad, "bad.yaml")
-        .unwrap_err()
-        .to_string()
+    SupervisorParams::from_yaml_str(&bad, "bad.yaml").unwrap_err().to_string()
 }
 
 #[test]
 fn unknown_task_names_file_and_key() {
-    let e = load_err(
-        "[goal, contact_reaction, avoidance]",
-        "[goal, contact_reactoin, avoidance]",
-    );
+    let e = load_err("[goal, contact_reaction, avoidance]", "[goal, contact_reactoin, avoidance]");
     assert!(
-        e.contains("bad.yaml")
-            && e.contains("arrangements.intentional_contact[1]")
-            && e.contains("contact_reactoin"),
+        e.contains("bad.yaml") && e.contains("arrangements.intentional_contact[1]") && e.contains("contact_reactoin"),
         "{e}"
     );
 }
 
 #[test]
 fn duplicate_task_in_arrangement_is_rejected() {
-    let e = load_err(
-        "[goal, contact_reaction, avoidance]",
-        "[goal, goal, avoidance]",
-    );
+    let e = load_err("[goal, contact_reaction, avoidance]", "[goal, goal, avoidance]");
     assert!(
-        e.contains("bad.yaml")
-            && e.contains("arrangements.intentional_contact[1]")
-            && e.contains("duplicate"),
+        e.contains("bad.yaml") && e.contains("arrangements.intentional_contact[1]") && e.contains("duplicate"),
         "{e}"
     );
 }
@@ -628,41 +545,24 @@ fn duplicate_task_in_arrangement_is_rejected() {
 #[test]
 fn negative_eps_names_file_and_key() {
     let e = load_err("speed_mps: 0.01 ", "speed_mps: -0.01 ");
-    assert!(
-        e.contains("bad.yaml") && e.contains("thresholds.speed_mps"),
-        "{e}"
-    );
+    assert!(e.contains("bad.yaml") && e.contains("thresholds.speed_mps"), "{e}");
     let e = load_err("contact_force_n: 5.0", "contact_force_n: -5.0");
-    assert!(
-        e.contains("bad.yaml") && e.contains("thresholds.contact_force_n"),
-        "{e}"
-    );
+    assert!(e.contains("bad.yaml") && e.contains("thresholds.contact_force_n"), "{e}");
 }
 
 #[test]
 fn hysteresis_larger_than_eps_c_is_rejected() {
     for band in ["contact_band_n: 6.0", "contact_band_n: 5.0"] {
         let e = load_err("contact_band_n: 1.5", band);
-        assert!(
-            e.contains("bad.yaml") && e.contains("thresholds.contact_band_n"),
-            "{e}"
-        );
+        assert!(e.contains("bad.yaml") && e.contains("thresholds.contact_band_n"), "{e}");
     }
 }
 
 #[test]
 fn other_invalid_values_are_rejected() {
     for (old, new, key) in [
-        (
-            "intentional_contact_m: 0.0",
-            "intentional_contact_m: 0.5",
-            "sensing_range.intentional_contact_m",
-        ),
-        (
-            "smoothing_gain_per_s: 10.0",
-            "smoothing_gain_per_s: 0.0",
-            "smoothing_gain_per_s",
-        ),
+        ("intentional_contact_m: 0.0", "intentional_contact_m: 0.5", "sensing_range.intentional_contact_m"),
+        ("smoothing_gain_per_s: 10.0", "smoothing_gain_per_s: 0.0", "smoothing_gain_per_s"),
         ("w_contact: 1.0", "w_contact: 1.5", "fusion.w_contact"),
         ("stuck_s: 0.5", "stuck_s: -0.5", "dwell.stuck_s"),
         ("log_capacity: 64", "log_capacity: 0", "log_capacity"),
@@ -722,12 +622,18 @@ fn follower_reproduces_the_deciding_supervisor() {
             assert_eq!(f.task_order(), a.task_order());
             assert_eq!(f.switch_time_s.to_bits(), a.switch_time_s.to_bits());
             assert_eq!(f.sensing_range_m, a.sensing_range_m);
-            assert!((f.fusion_weight - a.fusion_weight).abs() < 1e-12, "cycle {k}: w {} vs {}", f.fusion_weight, a.fusion_weight);
+            assert!(
+                (f.fusion_weight - a.fusion_weight).abs() < 1e-12,
+                "cycle {k}: w {} vs {}",
+                f.fusion_weight,
+                a.fusion_weight
+            );
         }
         assert!(decider.log().total() >= 1, "{:?}: something switched", params.policy);
     }
     let mut s = Supervisor::new(&params(), 0.0).unwrap();
-    let bad = Imposed { mode: Mode::Avoidance, switch_time_s: f64::NAN, sensing_range_m: 0.1, fusion_weight_target: 0.0 };
+    let bad =
+        Imposed { mode: Mode::Avoidance, switch_time_s: f64::NAN, sensing_range_m: 0.1, fusion_weight_target: 0.0 };
     assert!(s.impose(bad).is_err());
 }
 
@@ -750,7 +656,8 @@ fn a_crawl_without_goal_progress_is_stuck() {
         assert_eq!(sup.last_transition(), None, "progress is not a local minimum (t = {t})");
     }
     // then it crawls at the same speed without progress
-    let tr = run(&mut sup, &mut t, steps(2.0 * th.progress_window_s + p.dwell.stuck_s), input(crawl_speed, 3.0, 0.0, 0.3));
+    let tr =
+        run(&mut sup, &mut t, steps(2.0 * th.progress_window_s + p.dwell.stuck_s), input(crawl_speed, 3.0, 0.0, 0.3));
     assert_eq!(tr.len(), 1, "{tr:?}");
     assert_eq!((tr[0].to, tr[0].cause), (Mode::IntentionalContact, Cause::Stuck));
 }

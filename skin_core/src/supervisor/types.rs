@@ -6,27 +6,22 @@ use thiserror::Error;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[repr(u8)]
 pub enum Mode {
-    /// Paper 000 Table I (a): avoidance > goal > contact reaction (transitory phases).
+    /// Intentional-contact paper Table I (a): avoidance > goal > contact reaction (transitory phases).
     Avoidance = 0,
-    /// Paper 000 Table I (b): goal > contact reaction > avoidance (intentional contact).
+    /// Intentional-contact paper Table I (b): goal > contact reaction > avoidance (intentional contact).
     IntentionalContact = 1,
-    /// Paper 000 Table I (c): contact reaction > goal > avoidance (hard contact).
+    /// Intentional-contact paper Table I (c): contact reaction > goal > avoidance (hard contact).
     HardContact = 2,
-    /// Paper 003 Table 1, precontact phase.
+    /// Interactive-force-control paper Table 1, precontact phase.
     PreContact = 3,
-    /// Paper 003 Table 1, contact phase.
+    /// Interactive-force-control paper Table 1, contact phase.
     Contact = 4,
 }
 
 impl Mode {
     /// All modes, in discriminant order.
-    pub const ALL: [Mode; 5] = [
-        Mode::Avoidance,
-        Mode::IntentionalContact,
-        Mode::HardContact,
-        Mode::PreContact,
-        Mode::Contact,
-    ];
+    pub const ALL: [Mode; 5] =
+        [Mode::Avoidance, Mode::IntentionalContact, Mode::HardContact, Mode::PreContact, Mode::Contact];
 
     /// The `Arrangement.msg` mode constant.
     pub fn as_u8(self) -> u8 {
@@ -39,7 +34,7 @@ impl Mode {
     }
 }
 
-/// A paper 003 phase that can be requested (paper 003 Sec. 4.2.2: the switch is manual).
+/// A interactive-force-control paper phase that can be requested (interactive-force-control paper Sec. 4.2.2: the switch is manual).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Phase {
     /// Approach: hand distance control > wrist > tactile guidance > avoidance, posture.
@@ -84,9 +79,9 @@ pub struct SupervisorInput {
 /// Why a transition happened.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Cause {
-    /// Stopped near an obstacle with the goal not reached (paper 000 Table I (b) conditions).
+    /// Stopped near an obstacle with the goal not reached (intentional-contact paper Table I (b) conditions).
     Stuck,
-    /// Contact force at or above ε_c, or NaN (paper 000 Table I (c) condition).
+    /// Contact force at or above ε_c, or NaN (intentional-contact paper Table I (c) condition).
     ContactOverLimit,
     /// Contact force back below ε_c − band for the dwell time.
     ContactReleased,
@@ -96,7 +91,7 @@ pub enum Cause {
     ObstacleCleared,
     /// Speed, obstacle force or goal error NaN for the dwell time during intentional contact.
     InvalidInput,
-    /// A paper 003 phase request.
+    /// A interactive-force-control paper phase request.
     PhaseRequest,
     /// Decided by another supervisor (the `priority_supervisor` node), see
     /// [`super::Supervisor::impose`].
@@ -120,7 +115,7 @@ pub struct Imposed {
 /// One arrangement switch.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Transition {
-    /// The update time of the switch, `t_t` of paper 000 eq. (11) [s].
+    /// The update time of the switch, `t_t` of intentional-contact paper eq. (11) [s].
     pub t_s: f64,
     /// Mode before.
     pub from: Mode,
@@ -138,13 +133,13 @@ pub struct Arrangement {
     /// Indices into the configured task-name list, highest priority first (capacity reserved
     /// once, so switching does not allocate).
     pub(super) task_order: Vec<usize>,
-    /// `t_t` of paper 000 eq. (11): time of the last switch [s].
+    /// `t_t` of intentional-contact paper eq. (11): time of the last switch [s].
     pub switch_time_s: f64,
-    /// δ_t of paper 000 eq. (11) [1/s].
+    /// δ_t of intentional-contact paper eq. (11) [1/s].
     pub smoothing_gain_per_s: f64,
-    /// Current `d_range` of paper 000 eq. (3) [m] (ramps during (b) and back in (a)).
+    /// Current `d_range` of intentional-contact paper eq. (3) [m] (ramps during (b) and back in (a)).
     pub sensing_range_m: f64,
-    /// Current fusion weight `w` of paper 003 eq. (6) (follows the sigmoid after a phase switch).
+    /// Current fusion weight `w` of interactive-force-control paper eq. (6) (follows the sigmoid after a phase switch).
     pub fusion_weight: f64,
     /// The value `fusion_weight` goes to (what `Arrangement.msg` carries as `fusion_weight`).
     pub fusion_weight_target: f64,

@@ -1,4 +1,4 @@
-//! Paper 000 eq. (3)-(4): proximity avoidance as a force level, one directional row per cell.
+//! Intentional-contact paper eq. (3)-(4): proximity avoidance as a force level, one directional row per cell.
 //!
 //! For every cell `i` whose proximity signal gives a distance `d_i < d_range` (inverse proximity
 //! characteristic), the row is `(−n_i)ᵀ J_v(p_i)` (world inward normal, cell position) and its
@@ -17,8 +17,8 @@ use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::LengthMismatch;
 use crate::skin::layout::{ResolvedCell, ResolvedLayout};
-use crate::skin::repulsion::linear_repulsion;
 use crate::skin::live::LiveCells;
+use crate::skin::repulsion::linear_repulsion;
 
 /// Proximity avoidance over all cells of a layout.
 #[derive(Debug, Clone)]
@@ -62,9 +62,8 @@ impl ProximityAvoidance {
     ) -> Result<AvoidanceSummary, TaskError> {
         level.clear();
         let row = &mut self.row;
-        self.params.cells_in_range(layout, cells, range_m, |cell, fa| {
-            push_inward_cell_row(model, data, cell, fa, row, level)
-        })
+        self.params
+            .cells_in_range(layout, cells, range_m, |cell, fa| push_inward_cell_row(model, data, cell, fa, row, level))
     }
 
     /// The summary [`Self::update`] would return, without the rows (no Jacobians): what the

@@ -1,4 +1,4 @@
-//! Paper 003 eq. (15)-(17): mobile-base collision avoidance from 2D laser points.
+//! Interactive-force-control paper eq. (15)-(17): mobile-base collision avoidance from 2D laser points.
 //!
 //! Laser points are given in the base frame `{b}`. For each angular sector about the base origin
 //! the point `o_i` closest to the footprint rectangle is kept (so a dense wall counts once per
@@ -80,7 +80,14 @@ impl BaseAvoidance {
                 Vector2::new(c, s)
             })
             .collect();
-        Ok(Self { params, joints, best: vec![(f64::INFINITY, Vector2::zeros(), Vector2::zeros()); n], bounds, edges, tau: DVector::zeros(nv) })
+        Ok(Self {
+            params,
+            joints,
+            best: vec![(f64::INFINITY, Vector2::zeros(), Vector2::zeros()); n],
+            bounds,
+            edges,
+            tau: DVector::zeros(nv),
+        })
     }
 
     /// The sector of `p`: sector `s` spans the angles `atan2(y, x) + π ∈ [2π s/n, 2π (s+1)/n)`.

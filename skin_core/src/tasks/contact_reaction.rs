@@ -1,4 +1,4 @@
-//! Paper 000 eq. (6): contact reaction as a force level, one directional row per contact cell.
+//! Intentional-contact paper eq. (6): contact reaction as a force level, one directional row per contact cell.
 //!
 //! Sign choice: the touching object is outside the link, along the cell's outward normal `+n_i`;
 //! the measured contact force on the robot points inward (`−n_i`). The reaction yields to the

@@ -1,4 +1,4 @@
-//! Paper 000 eq. (7)-(9): end-effector goal with speed saturation, as a force level.
+//! Intentional-contact paper eq. (7)-(9): end-effector goal with speed saturation, as a force level.
 //!
 //! `ẋ_d = (k_p / k_v)(x_d − x)`, `ν = min(1, V_max / ‖ẋ_d‖)`, `F_g = −k_v (ẋ − ν ẋ_d)`.
 //! [`GoalPosition`] uses the 3 linear rows of the point Jacobian (world axes; a planar robot
@@ -21,7 +21,7 @@ pub fn saturated_goal_force(params: &GoalParams, error: &Vector3<f64>, velocity:
     -(velocity - xd_dot * nu) * params.kv_n_s_per_m
 }
 
-/// End-effector position goal (paper 000 eq. 7-9): 3 force rows at a point of a frame.
+/// End-effector position goal (intentional-contact paper eq. 7-9): 3 force rows at a point of a frame.
 #[derive(Debug, Clone)]
 pub struct GoalPosition {
     /// Frame (link) index of the end effector.
@@ -58,7 +58,7 @@ impl GoalPosition {
     }
 }
 
-/// End-effector orientation goal: the law of paper 000 eq. (7)-(9) on the angular rows.
+/// End-effector orientation goal: the law of intentional-contact paper eq. (7)-(9) on the angular rows.
 #[derive(Debug, Clone)]
 pub struct GoalOrientation {
     /// Frame (link) index of the end effector.

@@ -1,4 +1,4 @@
-//! Paper 003 eq. (9), Table 1: hand force / distance control on one acceleration row.
+//! Interactive-force-control paper eq. (9), Table 1: hand force / distance control on one acceleration row.
 //!
 //! Frame `{h}`: the hand frame, its z axis along the palm's outward normal, i.e. into the surface
 //! to be touched. The row is the third row of the hand body Jacobian, `z_hᵀ J_v(o_h)` (world
@@ -28,7 +28,7 @@ use crate::hierarchy::{Reference, TaskLevel};
 use crate::model::{ModelData, RobotModel};
 use crate::skin::characteristic::ProximityCharacteristic;
 
-/// What the hand task regulates this cycle (paper 003 Table 1).
+/// What the hand task regulates this cycle (interactive-force-control paper Table 1).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum HandMeasurement {
     /// Contact phase: the fused hand-patch signal `f_c` (z of the hand-frame patch force).
@@ -75,7 +75,8 @@ impl HandForce {
                 self.params.k_force_n_per_signal * (self.params.force_signal_desired - fused_signal)
             }
             HandMeasurement::Distance { proximity_signal } => {
-                self.params.k_distance_n_per_m * (proximity.distance_m(proximity_signal) - self.params.distance_desired_m)
+                self.params.k_distance_n_per_m
+                    * (proximity.distance_m(proximity_signal) - self.params.distance_desired_m)
             }
         }
     }

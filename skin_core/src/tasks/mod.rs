@@ -5,16 +5,16 @@
 //!
 //! | Task | Equation | Kind | Rows |
 //! |---|---|---|---|
-//! | [`goal::GoalPosition`] | paper 000 eq. (7)-(9) | force | 3 (linear, world) |
-//! | [`goal::GoalOrientation`] | paper 000 eq. (7)-(9) on `axis·angle(R_d Rᵀ)` | force | 3 (angular, world) |
-//! | [`avoidance::ProximityAvoidance`] | paper 000 eq. (3)-(4) | force | 1 per cell within `d_range` |
-//! | [`contact_reaction::ContactReaction`] | paper 000 eq. (6) | force | 1 per contact cell |
-//! | [`hand_force::HandForce`] | paper 003 eq. (9), Table 1 | acceleration | 1 (hand z) |
-//! | [`wrist::CompliantWrist`] | paper 003 eq. (10) | acceleration | 3 (angular, world) |
-//! | [`tactile_guidance::TactileGuidance`] | paper 003 eq. (11)-(12) | acceleration | 3 (linear, world) |
-//! | [`position_hold::PositionHold`] | paper 003 eq. (4), Table 1 | acceleration | 3 (linear, world) |
-//! | [`posture::Posture`] | paper 003 eq. (13)-(14), (18) | null-space torque | — |
-//! | [`base_avoidance::BaseAvoidance`] | paper 003 eq. (15)-(17) | torque (in `τ_s`) | — |
+//! | [`goal::GoalPosition`] | intentional-contact paper eq. (7)-(9) | force | 3 (linear, world) |
+//! | [`goal::GoalOrientation`] | intentional-contact paper eq. (7)-(9) on `axis·angle(R_d Rᵀ)` | force | 3 (angular, world) |
+//! | [`avoidance::ProximityAvoidance`] | intentional-contact paper eq. (3)-(4) | force | 1 per cell within `d_range` |
+//! | [`contact_reaction::ContactReaction`] | intentional-contact paper eq. (6) | force | 1 per contact cell |
+//! | [`hand_force::HandForce`] | interactive-force-control paper eq. (9), Table 1 | acceleration | 1 (hand z) |
+//! | [`wrist::CompliantWrist`] | interactive-force-control paper eq. (10) | acceleration | 3 (angular, world) |
+//! | [`tactile_guidance::TactileGuidance`] | interactive-force-control paper eq. (11)-(12) | acceleration | 3 (linear, world) |
+//! | [`position_hold::PositionHold`] | interactive-force-control paper eq. (4), Table 1 | acceleration | 3 (linear, world) |
+//! | [`posture::Posture`] | interactive-force-control paper eq. (13)-(14), (18) | null-space torque | — |
+//! | [`base_avoidance::BaseAvoidance`] | interactive-force-control paper eq. (15)-(17) | torque (in `τ_s`) | — |
 //!
 //! Parameters: [`params::TaskParams`] (`config/tasks.yaml`).
 
@@ -83,7 +83,7 @@ pub(crate) fn rows_times_qd(jac: &Matrix6xX<f64>, row0: usize, qd: &[f64]) -> Ve
     v
 }
 
-/// Reference acceleration of paper 003 eq. (4)/(5) per axis: `(k e − d ẋ) / λ`.
+/// Reference acceleration of interactive-force-control paper eq. (4)/(5) per axis: `(k e − d ẋ) / λ`.
 pub(crate) fn impedance_acceleration(
     imp: &params::Impedance3,
     error: &Vector3<f64>,

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::param_file::{load_validated, parse_validated, InvalidParam, ParamsError};
 
-/// Paper 000 eq. (7)-(9): goal task gains and speed limit (used for position and orientation).
+/// Intentional-contact paper eq. (7)-(9): goal task gains and speed limit (used for position and orientation).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GoalParams {
@@ -19,7 +19,7 @@ pub struct GoalParams {
     pub v_max_m_per_s: f64,
 }
 
-/// Paper 000 eq. (3): proximity avoidance `F_di = K (d_range - d_i)`.
+/// Intentional-contact paper eq. (3): proximity avoidance `F_di = K (d_range - d_i)`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AvoidanceParams {
@@ -33,7 +33,7 @@ pub struct AvoidanceParams {
     pub activation_band_m: f64,
 }
 
-/// Paper 000 eq. (6): contact reaction `F_ci = gain F_i` along the inward normal.
+/// Intentional-contact paper eq. (6): contact reaction `F_ci = gain F_i` along the inward normal.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactReactionParams {
@@ -44,7 +44,7 @@ pub struct ContactReactionParams {
     pub activation_force_n: f64,
 }
 
-/// Paper 003 eq. (9): hand force / distance control on one row.
+/// Interactive-force-control paper eq. (9): hand force / distance control on one row.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HandForceParams {
@@ -69,7 +69,7 @@ pub struct HandForceParams {
     pub approach_speed_min_mps: f64,
 }
 
-/// Impedance of a 3-row acceleration task, paper 003 eq. (4)/(5): diagonals of `Λ`, `K`, `D`.
+/// Impedance of a 3-row acceleration task, interactive-force-control paper eq. (4)/(5): diagonals of `Λ`, `K`, `D`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Impedance3 {
@@ -81,7 +81,7 @@ pub struct Impedance3 {
     pub d: [f64; 3],
 }
 
-/// Paper 003 eq. (15)-(17): mobile-base collision avoidance from laser points.
+/// Interactive-force-control paper eq. (15)-(17): mobile-base collision avoidance from laser points.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BaseAvoidanceParams {
@@ -99,7 +99,7 @@ pub struct BaseAvoidanceParams {
     pub sectors: usize,
 }
 
-/// Paper 003 eq. (18): joint compliance / posture.
+/// Interactive-force-control paper eq. (18): joint compliance / posture.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PostureParams {
@@ -136,25 +136,25 @@ pub struct BaseGains {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TaskParams {
-    /// End-effector position goal (paper 000 eq. 7-9).
+    /// End-effector position goal (intentional-contact paper eq. 7-9).
     pub goal: GoalParams,
     /// End-effector orientation goal (same law, angular rows).
     pub goal_orientation: GoalParams,
-    /// Proximity avoidance (paper 000 eq. 3).
+    /// Proximity avoidance (intentional-contact paper eq. 3).
     pub avoidance: AvoidanceParams,
-    /// Contact reaction (paper 000 eq. 6).
+    /// Contact reaction (intentional-contact paper eq. 6).
     pub contact_reaction: ContactReactionParams,
-    /// Hand force/distance (paper 003 eq. 9).
+    /// Hand force/distance (interactive-force-control paper eq. 9).
     pub hand_force: HandForceParams,
-    /// Compliant wrist (paper 003 eq. 10).
+    /// Compliant wrist (interactive-force-control paper eq. 10).
     pub wrist: Impedance3,
-    /// Tactile guidance (paper 003 eq. 11-12).
+    /// Tactile guidance (interactive-force-control paper eq. 11-12).
     pub tactile_guidance: Impedance3,
-    /// Cartesian position hold (paper 003 eq. 4, Table 1).
+    /// Cartesian position hold (interactive-force-control paper eq. 4, Table 1).
     pub position_hold: Impedance3,
-    /// Base collision avoidance (paper 003 eq. 15-17).
+    /// Base collision avoidance (interactive-force-control paper eq. 15-17).
     pub base_avoidance: BaseAvoidanceParams,
-    /// Joint compliance / posture (paper 003 eq. 18).
+    /// Joint compliance / posture (interactive-force-control paper eq. 18).
     pub posture: PostureParams,
 }
 
@@ -202,7 +202,14 @@ impl TaskParams {
         nonneg("hand_force.", "k_force_n_per_signal", h.k_force_n_per_signal)?;
         nonneg("hand_force.", "k_distance_n_per_m", h.k_distance_n_per_m)?;
         nonneg("hand_force.", "d_n_s_per_m", h.d_n_s_per_m)?;
-        InvalidParam::in_range("hand_force.", "force_signal_desired", h.force_signal_desired, 0.0, f64::MAX, "must be finite and >= 0")?;
+        InvalidParam::in_range(
+            "hand_force.",
+            "force_signal_desired",
+            h.force_signal_desired,
+            0.0,
+            f64::MAX,
+            "must be finite and >= 0",
+        )?;
         nonneg("hand_force.", "distance_desired_m", h.distance_desired_m)?;
         pos("hand_force.", "approach_time_s", h.approach_time_s)?;
         pos("hand_force.", "approach_speed_min_mps", h.approach_speed_min_mps)?;
@@ -214,13 +221,24 @@ impl TaskParams {
         pos("base_avoidance.", "alpha_m", b.alpha_m)?;
         nonneg("base_avoidance.", "range_m", b.range_m)?;
         for (name, r) in [("footprint_x_m", b.footprint_x_m), ("footprint_y_m", b.footprint_y_m)] {
-            InvalidParam::in_range("base_avoidance.", &format!("{name}[1]"), r[1], r[0], f64::INFINITY, "must be finite and >= the minimum")?;
+            InvalidParam::in_range(
+                "base_avoidance.",
+                &format!("{name}[1]"),
+                r[1],
+                r[0],
+                f64::INFINITY,
+                "must be finite and >= the minimum",
+            )?;
         }
         InvalidParam::in_range("base_avoidance.", "sectors", b.sectors as f64, 1.0, 360.0, "must be in [1, 360]")?;
         let p = &self.posture;
         for (name, v) in [("k_c", &p.k_c), ("d_c", &p.d_c)] {
             if v.is_empty() {
-                return Err(InvalidParam { key: format!("posture.{name}"), value: 0.0, reason: "needs at least one value" });
+                return Err(InvalidParam {
+                    key: format!("posture.{name}"),
+                    value: 0.0,
+                    reason: "needs at least one value",
+                });
             }
             for (i, x) in v.iter().enumerate() {
                 nonneg("posture.", &format!("{name}[{i}]"), *x)?;

@@ -1,6 +1,6 @@
 //! What the Cartesian tasks share: the Jacobian of a point on a frame with its drift `J̇ q̇`, turned
-//! into acceleration rows (paper 003 eq. 3), and one force row along a skin cell's inward normal
-//! (paper 000 eq. 4, 6).
+//! into acceleration rows (interactive-force-control paper eq. 3), and one force row along a skin cell's inward normal
+//! (intentional-contact paper eq. 4, 6).
 
 use nalgebra::{Matrix6xX, Vector3, Vector6};
 
@@ -67,7 +67,7 @@ impl PointRows {
 }
 
 /// Pushes one force row `f` [N] along the inward normal `−n` of `cell` (world axes), at the cell:
-/// the row `−nᵀ J_v(p)` of paper 000 eq. (4) / (6), with activation `a` in the null-space
+/// the row `−nᵀ J_v(p)` of intentional-contact paper eq. (4) / (6), with activation `a` in the null-space
 /// projector ([`TaskLevel::push_row_activated`]). `row` is scratch space (nv).
 pub(crate) fn push_inward_cell_row(
     model: &RobotModel,

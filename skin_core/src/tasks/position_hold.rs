@@ -1,4 +1,4 @@
-//! Paper 003 eq. (4), Table 1 (contact phase): Cartesian position hold of the hand at its
+//! Interactive-force-control paper eq. (4), Table 1 (contact phase): Cartesian position hold of the hand at its
 //! position when the phase began, `x_d = x_ef,init`: `ẍ* = Λ⁻¹(K Δx − D ẋ)`, `Δx = x_d − x`
 //! (`ẍ_d = 0`, no external wrench term), 3 world-aligned linear rows.
 
@@ -37,7 +37,12 @@ impl PositionHold {
     }
 
     /// Fills `level` (3 acceleration rows); returns `ẍ*`.
-    pub fn update(&mut self, model: &RobotModel, data: &ModelData, level: &mut TaskLevel) -> Result<Vector3<f64>, TaskError> {
+    pub fn update(
+        &mut self,
+        model: &RobotModel,
+        data: &ModelData,
+        level: &mut TaskLevel,
+    ) -> Result<Vector3<f64>, TaskError> {
         self.rows.update(model, data, self.frame, &self.point)?;
         let x = (data.frame_pose(self.frame) * Point3::from(self.point)).coords;
         let v = self.rows.velocity(LINEAR, data.qd());

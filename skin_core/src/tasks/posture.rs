@@ -1,10 +1,10 @@
-//! Paper 003 eq. (18): joint compliance and posture, the torque projected into the null space of
+//! Interactive-force-control paper eq. (18): joint compliance and posture, the torque projected into the null space of
 //! all levels: `τ_c* = −K_c (q − q_post) − D_c q̇ − τ_s` with
 //! `τ_s = k_skin τ_skin + τ_oca`: the body skin torque of eq. (13)-(14) (patch virtual wrenches,
 //! outward, so `−τ_skin` yields to the touch) and the base avoidance torque of eq. (15)-(17)
 //! ([`super::base_avoidance`], toward the obstacles, so `−τ_oca` moves away).
 //!
-//! A commanded base motion ([`BaseReference`], paper 003 Exp. 1's circle and swings) is this
+//! A commanded base motion ([`BaseReference`], interactive-force-control paper Exp. 1's circle and swings) is this
 //! level's reference: the base joints' `q_post` becomes the moving `q_d(t)` and their damping acts
 //! on `q̇ − q̇_d` (the velocity feed-forward), with the gains of `posture.base_tracking`. Being the
 //! lowest level, the motion only takes the null space of the hand's tasks: the arm keeps the hand.
@@ -100,7 +100,11 @@ impl Posture {
     /// Sets the commanded base motion of the base joints `joints` (model indices of x, y, yaw),
     /// or clears it (`None`: back to `q_post`). A non-finite value or a joint index out of range
     /// is refused (the previous reference stays).
-    pub fn set_base_reference(&mut self, joints: [usize; 3], reference: Option<BaseReference>) -> Result<(), TaskError> {
+    pub fn set_base_reference(
+        &mut self,
+        joints: [usize; 3],
+        reference: Option<BaseReference>,
+    ) -> Result<(), TaskError> {
         let nv = self.tau.len();
         if let Some(&j) = joints.iter().find(|&&j| j >= nv) {
             return Err(TaskError::Length { what: "base joint index", expected: nv, got: j });
@@ -138,7 +142,11 @@ impl Posture {
             return Err(TaskError::Length { what: "model nv", expected: nv, got: data.q().len() });
         }
         if wrenches.len() < layout.patches().len() {
-            return Err(TaskError::Length { what: "patch wrenches", expected: layout.patches().len(), got: wrenches.len() });
+            return Err(TaskError::Length {
+                what: "patch wrenches",
+                expected: layout.patches().len(),
+                got: wrenches.len(),
+            });
         }
         patch_wrenches_to_torques(model, data, layout, wrenches, include, &mut self.tau_skin);
         let (q, qd) = (data.q(), data.qd());

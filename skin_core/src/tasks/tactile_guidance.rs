@@ -1,4 +1,4 @@
-//! Paper 003 eq. (11)-(12): tactile guidance, 3 linear acceleration rows at the hand.
+//! Interactive-force-control paper eq. (11)-(12): tactile guidance, 3 linear acceleration rows at the hand.
 //!
 //! `ʰF_arm = Σ_j ʰR_{p_j} ᵖʲF` (eq. 11, `skin::transforms::sum_patch_forces_in_frame` over the
 //! arm patches) and `ʰẍ* = Λ⁻¹(−K ʰF_arm − D ʰẋ)` (eq. 12), evaluated in `{h}` and rotated to

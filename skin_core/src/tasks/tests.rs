@@ -11,14 +11,14 @@ use super::contact_reaction::ContactReaction;
 use super::goal::{saturated_goal_force, GoalOrientation, GoalPosition};
 use super::hand_force::{HandForce, HandMeasurement};
 use super::params::{HandForceParams, TaskParams};
-use crate::param_file::ParamsError;
 use super::position_hold::PositionHold;
 use super::posture::{BaseReference, Posture};
-use super::TaskError;
 use super::tactile_guidance::TactileGuidance;
 use super::wrist::CompliantWrist;
+use super::TaskError;
 use crate::hierarchy::{HierarchySolver, InverseParams, TaskLevel};
 use crate::model::{crba, point_jacobian, update_kinematics, ModelData, RobotModel};
+use crate::param_file::ParamsError;
 use crate::skin::aggregate::{aggregate_patches, PatchWrench};
 use crate::skin::layout::{ResolvedLayout, SkinLayout};
 use crate::skin::live::LiveCells;
@@ -134,7 +134,16 @@ fn avoidance_rows_magnitude_and_zero_range() {
     let mut task = ProximityAvoidance::new(s.model.nv(), s.params.avoidance);
     let mut level = TaskLevel::new("avoid", s.model.nv(), n);
     let range = s.params.avoidance.range_m;
-    let sum = task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), range, &mut level).unwrap();
+    let sum = task
+        .update(
+            &s.model,
+            &s.data,
+            &s.layout,
+            &LiveCells::from_readings(&readings, &s.skin.proximity),
+            range,
+            &mut level,
+        )
+        .unwrap();
     assert_eq!((level.rows(), sum.rows), (1, 1));
     assert_relative_eq!(level.target()[0], s.params.avoidance.gain_n_per_m * (range - d), epsilon = 1e-9);
     assert_relative_eq!(sum.force_norm_n, level.target()[0], epsilon = 1e-12);
@@ -146,7 +155,9 @@ fn avoidance_rows_magnitude_and_zero_range() {
     point_jacobian(&s.model, &s.data, cell.frame, &cell.position_link, &mut j).unwrap();
     assert!((j.fixed_rows::<3>(0) * qdd).dot(&nw) < 0.0);
     // the supervisor's range 0 disables the task
-    let sum = task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), 0.0, &mut level).unwrap();
+    let sum = task
+        .update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), 0.0, &mut level)
+        .unwrap();
     assert_eq!((level.rows(), sum.rows), (0, 0));
     assert_eq!(sum.force_norm_n, 0.0);
 }
@@ -166,7 +177,15 @@ fn avoidance_row_fades_in_at_the_range_boundary() {
         let d = range - k as f64 * 1e-3;
         let mut readings = vec![CellReading::uniform(0.0, 0.0); n];
         readings[5].proximity = s.skin.proximity.signal(d);
-        task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), range, &mut level).unwrap();
+        task.update(
+            &s.model,
+            &s.data,
+            &s.layout,
+            &LiveCells::from_readings(&readings, &s.skin.proximity),
+            range,
+            &mut level,
+        )
+        .unwrap();
         assert!(level.is_activated());
         let a = level.activation()[0];
         assert!(a >= prev && a - prev < 0.05, "activation {a} after {prev} at d = {d}");
@@ -187,7 +206,16 @@ fn contact_reaction_moves_touched_cell_along_minus_n() {
     readings[c] = CellReading::uniform(0.5, 1.0);
     let mut task = ContactReaction::new(s.model.nv(), s.params.contact_reaction, &s.skin.force);
     let mut level = TaskLevel::new("contact", s.model.nv(), n);
-    let sum = task.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), &s.skin.fusion, &mut level).unwrap();
+    let sum = task
+        .update(
+            &s.model,
+            &s.data,
+            &s.layout,
+            &LiveCells::from_readings(&readings, &s.skin.proximity),
+            &s.skin.fusion,
+            &mut level,
+        )
+        .unwrap();
     assert_eq!(level.rows(), 1);
     // eq. (6): the measured force times the gain, uncapped
     let expected = s.params.contact_reaction.gain * s.skin.force.force_n(0.5);
@@ -244,15 +272,28 @@ fn hand_force_sign_and_row() {
     let mut task = HandForce::new(s.model.nv(), hand, s.params.hand_force);
     let mut level = TaskLevel::new("hand", s.model.nv(), 1);
     // force below the reference: accelerate into the surface (+z_h)
-    let xdd = task.update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.0 }, 0.0, &s.skin.proximity, &mut level).unwrap();
+    let xdd = task
+        .update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.0 }, 0.0, &s.skin.proximity, &mut level)
+        .unwrap();
     assert!(xdd > 0.0);
     let h = s.params.hand_force;
     assert_relative_eq!(xdd, h.k_force_n_per_signal * h.force_signal_desired / h.lambda_kg, epsilon = 1e-12);
     // too much force: back off
-    let xdd = task.update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.9 }, 0.0, &s.skin.proximity, &mut level).unwrap();
+    let xdd = task
+        .update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.9 }, 0.0, &s.skin.proximity, &mut level)
+        .unwrap();
     assert!(xdd < 0.0);
     // far away in distance mode: approach
-    let xdd = task.update(&s.model, &s.data, HandMeasurement::Distance { proximity_signal: 0.05 }, 0.05, &s.skin.proximity, &mut level).unwrap();
+    let xdd = task
+        .update(
+            &s.model,
+            &s.data,
+            HandMeasurement::Distance { proximity_signal: 0.05 },
+            0.05,
+            &s.skin.proximity,
+            &mut level,
+        )
+        .unwrap();
     assert!(xdd > 0.0);
     // the row is z_hᵀ J_v
     let mut j = Matrix6xX::zeros(s.model.nv());
@@ -348,7 +389,9 @@ fn a_base_reference_replaces_q_post_on_the_base_joints_only() {
     for i in 0..nv {
         let expected = match joints.iter().position(|&j| j == i) {
             // eq. (18) with q_d(t), q̇_d(t) and the tracking gains
-            Some(k) => -gains.k_c[k] * (s.q[i] - reference.position[k]) - gains.d_c[k] * (qd[i] - reference.velocity[k]),
+            Some(k) => {
+                -gains.k_c[k] * (s.q[i] - reference.position[k]) - gains.d_c[k] * (qd[i] - reference.velocity[k])
+            }
             None => -posture.d_c[i] * qd[i],
         };
         assert_relative_eq!(tau[i], expected, epsilon = 1e-12);
@@ -400,7 +443,8 @@ fn three_tasks_and_posture_through_the_solver() {
     let hand = s.model.frame_index("right_hand").unwrap();
     let qd: Vec<f64> = (0..nv).map(|i| 0.02 * i as f64).collect();
     update_kinematics(&s.model, &mut s.data, &s.q, &qd).unwrap();
-    let readings: Vec<CellReading> = (0..n).map(|i| CellReading::uniform((i % 7) as f64 / 10.0, (i % 5) as f64 / 5.0)).collect();
+    let readings: Vec<CellReading> =
+        (0..n).map(|i| CellReading::uniform((i % 7) as f64 / 10.0, (i % 5) as f64 / 5.0)).collect();
     let mut wrenches = Vec::new();
     aggregate_patches(&s.layout, &readings, &s.skin.fusion, &mut wrenches).unwrap();
 
@@ -411,9 +455,13 @@ fn three_tasks_and_posture_through_the_solver() {
     let mut posture = Posture::new(nv, &s.params.posture, &vec![0.0; nv]).unwrap();
     let mut levels = [TaskLevel::new("avoid", nv, n), TaskLevel::new("hand", nv, 1), TaskLevel::new("hold", nv, 3)];
     let [l0, l1, l2] = &mut levels;
-    let sum = avoid.update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), 0.1, l0).unwrap();
+    let sum = avoid
+        .update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), 0.1, l0)
+        .unwrap();
     assert!(sum.rows > 0);
-    hand_task.update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.1 }, 0.0, &s.skin.proximity, l1).unwrap();
+    hand_task
+        .update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.1 }, 0.0, &s.skin.proximity, l1)
+        .unwrap();
     hold.update(&s.model, &s.data, l2).unwrap();
     let tau_c = posture.update(&s.model, &s.data, &s.layout, &wrenches, |_| true, None, true).unwrap().clone();
     let mut solver = HierarchySolver::new(nv, 3, n, InverseParams::default()).unwrap();

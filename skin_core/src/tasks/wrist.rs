@@ -1,8 +1,8 @@
-//! Paper 003 eq. (10): compliant wrist, 3 angular acceleration rows driving the hand-patch
+//! Interactive-force-control paper eq. (10): compliant wrist, 3 angular acceleration rows driving the hand-patch
 //! moment `Γ` to zero.
 //!
 //! `ω̇* = Λ⁻¹(−K Γ − D ω)` with the rotational rows of the hand Jacobian (world axes) and `Γ`
-//! the hand patch moment (paper 003 eq. 8) rotated into world axes. The patch moment is that of
+//! the hand patch moment (interactive-force-control paper eq. 8) rotated into world axes. The patch moment is that of
 //! the outward virtual forces; a more loaded side gives a moment whose negative rotates that side
 //! back, away from the surface, so the pressure evens out (the paper writes the same law in `{h}`;
 //! with isotropic gains the two are identical).

@@ -19,7 +19,7 @@ use skin_sim::scene::RunOverrides;
 use skin_sim::study::{self, StudyResults, StudyScenario};
 
 #[derive(Parser)]
-#[command(version, about = "Closed-loop MuJoCo scenarios of skin_control (papers 000 and 003)", long_about = None)]
+#[command(version, about = "Closed-loop MuJoCo scenarios of skin_control (intentional-contact and interactive-force-control papers)", long_about = None)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -96,7 +96,13 @@ struct SweepArgs {
 
 /// The products of a run (`skin_sim::outputs::ALL`), the video when asked for.
 fn outputs(video: bool) -> Vec<Box<dyn RunOutput>> {
-    vec![Box::new(MetricsJson), Box::new(SummaryText), Box::new(FigurePng), Box::new(RunBag), Box::new(KeyFrames { video })]
+    vec![
+        Box::new(MetricsJson),
+        Box::new(SummaryText),
+        Box::new(FigurePng),
+        Box::new(RunBag),
+        Box::new(KeyFrames { video }),
+    ]
 }
 
 /// A progress line on stderr, redrawn at most every 2 % of the run on a terminal (every 25 %
@@ -144,14 +150,20 @@ fn sweep(args: SweepArgs) -> anyhow::Result<bool> {
             let points = study::grid_points(&scenarios, args.full)?;
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
             let jobs = args.jobs.unwrap_or(cores).max(1);
-            eprintln!("study: {} points over {} scenarios on {jobs} threads ({} build)", points.len(), scenarios.len(), study::profile());
+            eprintln!(
+                "study: {} points over {} scenarios on {jobs} threads ({} build)",
+                points.len(),
+                scenarios.len(),
+                study::profile()
+            );
             let started = Instant::now();
             let points = study::run(&scenarios, &points, jobs, &args.out.join("variants"), |done, total, r| {
                 if !args.quiet {
                     eprintln!("{}", study::progress_line(done, total, r, started));
                 }
             })?;
-            let command = std::iter::once("skin_sim".to_string()).chain(std::env::args().skip(1)).collect::<Vec<_>>().join(" ");
+            let command =
+                std::iter::once("skin_sim".to_string()).chain(std::env::args().skip(1)).collect::<Vec<_>>().join(" ");
             let results = StudyResults {
                 command,
                 grid: if args.full { "full" } else { "default" }.into(),
@@ -191,12 +203,7 @@ fn run(args: Command) -> anyhow::Result<bool> {
         }
     };
     let target = RunTarget::resolve(&target, controller).map_err(anyhow::Error::msg)?;
-    let overrides = RunOverrides {
-        duration_s: duration,
-        timestep_s: dt,
-        control_rate_hz: control_rate,
-        seed,
-    };
+    let overrides = RunOverrides { duration_s: duration, timestep_s: dt, control_rate_hz: control_rate, seed };
     let mut progress = (!quiet).then(|| progress_line(target.name.clone(), duration));
     let report = target.run(&overrides, |done| {
         if let Some(p) = &mut progress {

@@ -15,37 +15,19 @@ fn primitives(shape: &ShapeSpec) -> Vec<(Shape, Isometry3<f64>)> {
     let at = |x: f64, y: f64, z: f64| Isometry3::translation(x, y, z);
     match *shape {
         ShapeSpec::Box { size_m } => vec![(Shape::Box { size: Vector3::from(size_m) }, Isometry3::identity())],
-        ShapeSpec::Cylinder { radius_m, length_m } => vec![(
-            Shape::Cylinder {
-                radius: radius_m,
-                length: length_m,
-            },
-            Isometry3::identity(),
-        )],
+        ShapeSpec::Cylinder { radius_m, length_m } => {
+            vec![(Shape::Cylinder { radius: radius_m, length: length_m }, Isometry3::identity())]
+        }
         ShapeSpec::Sphere { radius_m } => vec![(Shape::Sphere { radius: radius_m }, Isometry3::identity())],
-        ShapeSpec::Capsule { radius_m, length_m } => vec![(
-            Shape::Capsule {
-                radius: radius_m,
-                length: length_m,
-            },
-            Isometry3::identity(),
-        )],
-        ShapeSpec::Table {
-            top_m,
-            height_m,
-            leg_radius_m,
-        } => {
+        ShapeSpec::Capsule { radius_m, length_m } => {
+            vec![(Shape::Capsule { radius: radius_m, length: length_m }, Isometry3::identity())]
+        }
+        ShapeSpec::Table { top_m, height_m, leg_radius_m } => {
             let leg = height_m - top_m[2];
             let (lx, ly) = (top_m[0] / 2.0 - leg_radius_m, top_m[1] / 2.0 - leg_radius_m);
             let mut parts = vec![(Shape::Box { size: Vector3::from(top_m) }, at(0.0, 0.0, height_m - top_m[2] / 2.0))];
             for (sx, sy) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
-                parts.push((
-                    Shape::Cylinder {
-                        radius: leg_radius_m,
-                        length: leg,
-                    },
-                    at(sx * lx, sy * ly, leg / 2.0),
-                ));
+                parts.push((Shape::Cylinder { radius: leg_radius_m, length: leg }, at(sx * lx, sy * ly, leg / 2.0)));
             }
             parts
         }
@@ -69,12 +51,7 @@ fn volume(shape: &Shape) -> f64 {
 /// `contact_time_constant_s` (MuJoCo `solref`) the softness of those contacts.
 pub(super) fn object_xml(o: &ObjectSpec, xml: &mut String) {
     let parts = primitives(&o.shape);
-    let _ = writeln!(
-        xml,
-        "    <body name=\"{}\" {}>",
-        o.name,
-        pose_attrs(&isometry_from_xyz_rpy(&o.xyz, &o.rpy))
-    );
+    let _ = writeln!(xml, "    <body name=\"{}\" {}>", o.name, pose_attrs(&isometry_from_xyz_rpy(&o.xyz, &o.rpy)));
     let density = match o.mass_kg {
         Some(m) => {
             xml.push_str("      <freejoint/>\n");

@@ -99,11 +99,7 @@ pub(super) fn robot_xml(scene: &Scene) -> Result<RobotXml, MjcfError> {
         );
     }
     actuators.push_str("  </actuator>\n");
-    Ok(RobotXml {
-        bodies,
-        contact,
-        actuators,
-    })
+    Ok(RobotXml { bodies, contact, actuators })
 }
 
 /// The body of joint `j` and, recursively, its children.
@@ -118,17 +114,8 @@ fn body_xml(
     let pad = "  ".repeat(depth);
     let moving = scene.moving[j];
     // A frozen joint is welded at its fixed position: its motion is folded into the placement.
-    let pose = if moving {
-        placement[j]
-    } else {
-        placement[j] * joint_motion(model, j, scene.q0[j])
-    };
-    let _ = writeln!(
-        xml,
-        "{pad}<body name=\"{}\" {} gravcomp=\"1\">",
-        body_name(model, j),
-        pose_attrs(&pose)
-    );
+    let pose = if moving { placement[j] } else { placement[j] * joint_motion(model, j, scene.q0[j]) };
+    let _ = writeln!(xml, "{pad}<body name=\"{}\" {} gravcomp=\"1\">", body_name(model, j), pose_attrs(&pose));
     let (c, i) = (model.body_com(j), model.body_inertia(j));
     let _ = writeln!(
         xml,
@@ -188,9 +175,7 @@ fn joint_motion(model: &RobotModel, j: usize, q: f64) -> Isometry3<f64> {
 fn frame_geoms(model: &RobotModel, f: usize, pad: &str, xml: &mut String) -> Result<(), MjcfError> {
     for c in model.link_collisions(f) {
         let pose = model.frame_placement(f) * c.origin;
-        let shape = shape_attrs(&c.shape).ok_or_else(|| MjcfError::Mesh {
-            link: model.frame_names()[f].clone(),
-        })?;
+        let shape = shape_attrs(&c.shape).ok_or_else(|| MjcfError::Mesh { link: model.frame_names()[f].clone() })?;
         let _ = writeln!(xml, "{pad}<geom {shape} {} group=\"{ROBOT_GROUP}\"/>", pose_attrs(&pose));
     }
     Ok(())

@@ -38,10 +38,7 @@ pub(super) fn to_svg(fig: &Figure, path: &Path) -> Result<(), String> {
 pub(super) fn to_rgb(fig: &Figure) -> Result<Vec<u8>, String> {
     let (w, h) = fig.pixel_size();
     let mut buf = vec![0u8; w as usize * h as usize * 3];
-    draw(
-        fig,
-        &BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area(),
-    )?;
+    draw(fig, &BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area())?;
     Ok(buf)
 }
 
@@ -54,8 +51,7 @@ pub(crate) fn font() -> Result<(), String> {
     static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
     REGISTERED
         .get_or_init(|| {
-            register_font(FONT, FontStyle::Normal, FONT_TTF)
-                .map_err(|_| "the shipped font is not a valid TTF".into())
+            register_font(FONT, FontStyle::Normal, FONT_TTF).map_err(|_| "the shipped font is not a valid TTF".into())
         })
         .clone()
 }
@@ -68,17 +64,8 @@ fn draw<DB: DrawingBackend>(fig: &Figure, root: &DrawingArea<DB, Shift>) -> Resu
     let time = time_range(fig);
     let areas = body.split_evenly((fig.panels.len().max(1), 1));
     for (i, (panel, area)) in fig.panels.iter().zip(&areas).enumerate() {
-        let shading = Shading {
-            intervals: &fig.intervals,
-            in_legend: i == 0,
-        };
-        draw_panel(
-            panel,
-            area,
-            time.clone(),
-            i + 1 == fig.panels.len(),
-            &shading,
-        )?;
+        let shading = Shading { intervals: &fig.intervals, in_legend: i == 0 };
+        draw_panel(panel, area, time.clone(), i + 1 == fig.panels.len(), &shading)?;
     }
     root.present().map_err(err)
 }
@@ -132,24 +119,20 @@ fn draw_panel<DB: DrawingBackend>(
         mesh.x_desc("time [s]");
     }
     if !categories.is_empty() {
-        mesh.y_labels(2 * categories.len() + 1)
-            .y_label_formatter(&category_label);
+        mesh.y_labels(2 * categories.len() + 1).y_label_formatter(&category_label);
     }
     mesh.draw().map_err(err)?;
 
     let mut labelled = false;
     for (k, iv) in shading.intervals.iter().enumerate() {
         let tint = rgb(iv.tint);
-        let rect = Rectangle::new(
-            [(iv.start, y.start), (iv.end, y.end)],
-            tint.mix(0.15).filled(),
-        );
+        let rect = Rectangle::new([(iv.start, y.start), (iv.end, y.end)], tint.mix(0.15).filled());
         let drawn = chart.draw_series(std::iter::once(rect)).map_err(err)?;
         let first_of_label = shading.intervals[..k].iter().all(|o| o.label != iv.label);
         if shading.in_legend && first_of_label {
-            drawn.label(&iv.label).legend(move |(x, y)| {
-                Rectangle::new([(x, y - 5), (x + 16, y + 5)], tint.mix(0.4).filled())
-            });
+            drawn
+                .label(&iv.label)
+                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 16, y + 5)], tint.mix(0.4).filled()));
             labelled = true;
         }
     }
@@ -159,13 +142,9 @@ fn draw_panel<DB: DrawingBackend>(
             for (j, line) in lines.iter().enumerate() {
                 let style = PALETTE[j % PALETTE.len()].stroke_width(2);
                 for (k, segment) in finite_segments(&line.t, &line.y).into_iter().enumerate() {
-                    let drawn = chart
-                        .draw_series(LineSeries::new(segment, style))
-                        .map_err(err)?;
+                    let drawn = chart.draw_series(LineSeries::new(segment, style)).map_err(err)?;
                     if k == 0 {
-                        drawn
-                            .label(&line.name)
-                            .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], style));
+                        drawn.label(&line.name).legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], style));
                         labelled = true;
                     }
                 }
@@ -177,17 +156,13 @@ fn draw_panel<DB: DrawingBackend>(
                     .draw_series(DashedLineSeries::new(points, 8, 5, style))
                     .map_err(err)?
                     .label(&th.name)
-                    .legend(move |(x, y)| {
-                        PathElement::new([(x, y), (x + 6, y), (x + 10, y), (x + 16, y)], style)
-                    });
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 6, y), (x + 10, y), (x + 16, y)], style));
                 labelled = true;
             }
         }
         Content::Steps { t, state, .. } => {
             let style = PALETTE[0].stroke_width(2);
-            chart
-                .draw_series(LineSeries::new(step_points(t, state), style))
-                .map_err(err)?;
+            chart.draw_series(LineSeries::new(step_points(t, state), style)).map_err(err)?;
         }
     }
 
@@ -254,10 +229,7 @@ fn time_range(fig: &Figure) -> Range<f64> {
 fn y_range(panel: &Panel) -> Range<f64> {
     match &panel.content {
         Content::Lines { lines, thresholds } => {
-            let values = lines
-                .iter()
-                .flat_map(|l| l.y.iter().copied())
-                .chain(thresholds.iter().map(|t| t.value));
+            let values = lines.iter().flat_map(|l| l.y.iter().copied()).chain(thresholds.iter().map(|t| t.value));
             span(values, 0.06)
         }
         Content::Steps { categories, .. } => -0.5..categories.len() as f64 - 0.5,
@@ -266,11 +238,8 @@ fn y_range(panel: &Panel) -> Range<f64> {
 
 /// min..max of the finite values, widened by `pad` of the span on each side; never empty.
 fn span(values: impl Iterator<Item = f64>, pad: f64) -> Range<f64> {
-    let (lo, hi) = values
-        .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-            (lo.min(v), hi.max(v))
-        });
+    let (lo, hi) =
+        values.filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
     if lo > hi {
         return 0.0..1.0;
     }

@@ -2,7 +2,7 @@
 
 use super::{intervals_where, Figure, Panel, Tint};
 
-/// Signals of a paper 000 run, laid out like its Figs. 3, 7 and 8; one sample per control cycle,
+/// Signals of an intentional-contact paper run, laid out like its Figs. 3, 7 and 8; one sample per control cycle,
 /// every slice as long as `t`.
 #[derive(Debug, Clone, Copy)]
 pub struct Paper000Signals<'a> {
@@ -27,7 +27,7 @@ pub struct Paper000Signals<'a> {
     pub pushes: &'a [(f64, f64)],
 }
 
-/// Paper 000's figure: (a) arrangement, (b) end-effector speed with eps_v, (c) proximity force,
+/// Intentional-contact paper's figure: (a) arrangement, (b) end-effector speed with eps_v, (c) proximity force,
 /// (d) contact force with eps_c, (e) torque norm; intentional-contact periods (arrangement (b))
 /// and pushes shaded.
 pub fn paper000_figure(title: &str, s: &Paper000Signals) -> Figure {
@@ -46,13 +46,11 @@ pub fn paper000_figure(title: &str, s: &Paper000Signals) -> Figure {
                 .line("||x_dot||", t, s.ee_speed)
                 .threshold("eps_v", s.eps_v),
         )
-        .panel(
-            Panel::lines("(c) Proximity force at the closest point", "force [N]").line(
-                "||F_d||",
-                t,
-                s.avoidance_force,
-            ),
-        )
+        .panel(Panel::lines("(c) Proximity force at the closest point", "force [N]").line(
+            "||F_d||",
+            t,
+            s.avoidance_force,
+        ))
         .panel(
             Panel::lines("(d) Largest contact force", "force [N]")
                 .line("||F_c||", t, s.contact_force)
@@ -68,7 +66,7 @@ pub fn paper000_figure(title: &str, s: &Paper000Signals) -> Figure {
     fig
 }
 
-/// Signals of a paper 003 force experiment, laid out like its Figs. 5, 7 and 8; one sample per
+/// Signals of a interactive-force-control paper force experiment, laid out like its Figs. 5, 7 and 8; one sample per
 /// control cycle, every slice as long as `t`.
 #[derive(Debug, Clone, Copy)]
 pub struct Paper003Signals<'a> {
@@ -91,29 +89,17 @@ pub struct Paper003Signals<'a> {
     pub interaction: &'a [(f64, f64)],
 }
 
-/// Paper 003's figure: (a) desired and measured hand force, (b) force error with its RMS over
+/// Interactive-force-control paper's figure: (a) desired and measured hand force, (b) force error with its RMS over
 /// the contact phase (the measure of Table 3), (c) phase, (d) fusion weight, (e) base speed;
 /// tactile and base-avoidance periods shaded.
 pub fn paper003_figure(title: &str, s: &Paper003Signals) -> Figure {
     let t = s.t;
-    let error: Vec<f64> = s
-        .force_measured
-        .iter()
-        .zip(s.force_desired)
-        .map(|(m, d)| m - d)
-        .collect();
-    let in_contact = error
-        .iter()
-        .zip(s.phase)
-        .filter(|(_, &p)| p == 1)
-        .map(|(e, _)| e * e);
+    let error: Vec<f64> = s.force_measured.iter().zip(s.force_desired).map(|(m, d)| m - d).collect();
+    let in_contact = error.iter().zip(s.phase).filter(|(_, &p)| p == 1).map(|(e, _)| e * e);
     let (sum, n) = in_contact.fold((0.0, 0usize), |(sum, n), e2| (sum + e2, n + 1));
     let error_title = match n {
         0 => "(b) Force error".to_string(),
-        _ => format!(
-            "(b) Force error (RMS in contact {:.3} N)",
-            (sum / n as f64).sqrt()
-        ),
+        _ => format!("(b) Force error (RMS in contact {:.3} N)", (sum / n as f64).sqrt()),
     };
     let mut fig = Figure::new(title)
         .panel(
@@ -123,19 +109,9 @@ pub fn paper003_figure(title: &str, s: &Paper003Signals) -> Figure {
                 .line("desired", t, s.force_desired),
         )
         .panel(Panel::lines(&error_title, "error [N]").line("measured - desired", t, &error))
-        .panel(Panel::steps(
-            "(c) Phase (Table 1)",
-            "phase",
-            &["pre-contact", "contact"],
-            t,
-            s.phase,
-        ))
+        .panel(Panel::steps("(c) Phase (Table 1)", "phase", &["pre-contact", "contact"], t, s.phase))
         .panel(Panel::lines("(d) Fusion weight (eq. 6)", "w [-]").line("w", t, s.fusion_weight))
-        .panel(Panel::lines("(e) Mobile-base speed", "speed [m/s]").line(
-            "||v_b||",
-            t,
-            s.base_speed,
-        ));
+        .panel(Panel::lines("(e) Mobile-base speed", "speed [m/s]").line("||v_b||", t, s.base_speed));
     for &(a, b) in s.tactile {
         fig = fig.shade(a, b, "tactile guidance", Tint::Green);
     }
@@ -145,7 +121,7 @@ pub fn paper003_figure(title: &str, s: &Paper003Signals) -> Figure {
     fig
 }
 
-/// Signals of paper 003's Exp. 2 (pre-contact approach and tactile guidance), laid out like its
+/// Signals of interactive-force-control paper's Exp. 2 (pre-contact approach and tactile guidance), laid out like its
 /// Fig. 6; one sample per control cycle, every slice as long as `t`.
 #[derive(Debug, Clone, Copy)]
 pub struct GuidanceSignals<'a> {
@@ -166,16 +142,18 @@ pub struct GuidanceSignals<'a> {
     pub interaction: &'a [(f64, f64)],
 }
 
-/// Paper 003 Fig. 6: (a) the hand's distance to the surface against `d_p,d`, (b) the skin
+/// Interactive-force-control paper Fig. 6: (a) the hand's distance to the surface against `d_p,d`, (b) the skin
 /// moments `ʰΓ` the compliant wrist drives to zero (left out when not recorded: runs through the
 /// ROS graph), (c) the hand's position (guided along the surface by the touches), (d) the base's
 /// position (moved by base collision avoidance); interaction periods shaded.
 pub fn guidance_figure(title: &str, s: &GuidanceSignals) -> Figure {
     let t = s.t;
     let mut fig = Figure::new(title).panel(
-        Panel::lines("(a) Hand distance to the surface", "d_p [m]")
-            .line("measured", t, s.distance)
-            .line("desired", t, s.distance_desired),
+        Panel::lines("(a) Hand distance to the surface", "d_p [m]").line("measured", t, s.distance).line(
+            "desired",
+            t,
+            s.distance_desired,
+        ),
     );
     if s.moment.iter().any(|m| m.iter().any(|v| v.is_finite())) {
         fig = fig.panel(

@@ -25,7 +25,9 @@ use thiserror::Error;
 
 // The study's charts (`crate::study::charts`) draw with the same font and colours.
 pub(crate) use draw::{font, FONT, PALETTE};
-pub use layouts::{guidance_figure, paper000_figure, paper003_figure, GuidanceSignals, Paper000Signals, Paper003Signals};
+pub use layouts::{
+    guidance_figure, paper000_figure, paper003_figure, GuidanceSignals, Paper000Signals, Paper003Signals,
+};
 
 /// Errors building or writing a figure; each names the output file.
 #[derive(Debug, Error)]
@@ -88,16 +90,9 @@ struct Threshold {
 #[derive(Debug, Clone)]
 enum Content {
     /// Continuous signals and thresholds.
-    Lines {
-        lines: Vec<Line>,
-        thresholds: Vec<Threshold>,
-    },
+    Lines { lines: Vec<Line>, thresholds: Vec<Threshold> },
     /// A categorical state held from one sample to the next (e.g. the active arrangement).
-    Steps {
-        categories: Vec<String>,
-        t: Vec<f64>,
-        state: Vec<usize>,
-    },
+    Steps { categories: Vec<String>, t: Vec<f64>, state: Vec<usize> },
 }
 
 /// One panel: a title, a y label with units, and its content.
@@ -111,46 +106,25 @@ pub struct Panel {
 impl Panel {
     /// A panel of lines; add them with [`Panel::line`] and [`Panel::threshold`].
     pub fn lines(title: &str, y_label: &str) -> Self {
-        let content = Content::Lines {
-            lines: Vec::new(),
-            thresholds: Vec::new(),
-        };
-        Self {
-            title: title.into(),
-            y_label: y_label.into(),
-            content,
-        }
+        let content = Content::Lines { lines: Vec::new(), thresholds: Vec::new() };
+        Self { title: title.into(), y_label: y_label.into(), content }
     }
 
     /// A step panel: `state[k]` (an index into `categories`) holds from `t[k]` to `t[k + 1]`.
-    pub fn steps(
-        title: &str,
-        y_label: &str,
-        categories: &[&str],
-        t: &[f64],
-        state: &[usize],
-    ) -> Self {
+    pub fn steps(title: &str, y_label: &str, categories: &[&str], t: &[f64], state: &[usize]) -> Self {
         let content = Content::Steps {
             categories: categories.iter().map(|c| c.to_string()).collect(),
             t: t.to_vec(),
             state: state.to_vec(),
         };
-        Self {
-            title: title.into(),
-            y_label: y_label.into(),
-            content,
-        }
+        Self { title: title.into(), y_label: y_label.into(), content }
     }
 
     /// Add the line `name` with samples `(t[k], y[k])`; non-finite values leave a gap. No-op on a
     /// step panel.
     pub fn line(mut self, name: &str, t: &[f64], y: &[f64]) -> Self {
         if let Content::Lines { lines, .. } = &mut self.content {
-            lines.push(Line {
-                name: name.into(),
-                t: t.to_vec(),
-                y: y.to_vec(),
-            });
+            lines.push(Line { name: name.into(), t: t.to_vec(), y: y.to_vec() });
         }
         self
     }
@@ -158,10 +132,7 @@ impl Panel {
     /// Add a dashed horizontal line at `value`. No-op on a step panel.
     pub fn threshold(mut self, name: &str, value: f64) -> Self {
         if let Content::Lines { thresholds, .. } = &mut self.content {
-            thresholds.push(Threshold {
-                name: name.into(),
-                value,
-            });
+            thresholds.push(Threshold { name: name.into(), value });
         }
         self
     }
@@ -179,12 +150,8 @@ impl Panel {
                 Some(l) => Err(length(&l.name, l.t.len(), l.y.len())),
                 None => Ok(()),
             },
-            Content::Steps { t, state, .. } if t.len() != state.len() => {
-                Err(length("state", t.len(), state.len()))
-            }
-            Content::Steps {
-                categories, state, ..
-            } => match state.iter().find(|&&s| s >= categories.len()) {
+            Content::Steps { t, state, .. } if t.len() != state.len() => Err(length("state", t.len(), state.len())),
+            Content::Steps { categories, state, .. } => match state.iter().find(|&&s| s >= categories.len()) {
                 Some(&s) => Err(PlotError::Category {
                     path: path.to_path_buf(),
                     panel: self.title.clone(),
@@ -197,7 +164,7 @@ impl Panel {
     }
 }
 
-/// Colour of a shaded interval (paper 003 marks tactile guidance green, base collision avoidance
+/// Colour of a shaded interval (interactive-force-control paper marks tactile guidance green, base collision avoidance
 /// red, object motion yellow).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Tint {
@@ -238,13 +205,7 @@ const TITLE_HEIGHT: u32 = 36;
 impl Figure {
     /// An empty figure, 1000 px wide with 190 px per panel.
     pub fn new(title: &str) -> Self {
-        Self {
-            title: title.into(),
-            width: 1000,
-            panel_height: 190,
-            panels: Vec::new(),
-            intervals: Vec::new(),
-        }
+        Self { title: title.into(), width: 1000, panel_height: 190, panels: Vec::new(), intervals: Vec::new() }
     }
 
     /// Set the width and the height of each panel \[px\].
@@ -262,49 +223,32 @@ impl Figure {
 
     /// Shade `[start, end]` \[s\] in every panel; the label goes in the top panel's legend (once).
     pub fn shade(mut self, start: f64, end: f64, label: &str, tint: Tint) -> Self {
-        self.intervals.push(Interval {
-            start,
-            end,
-            label: label.into(),
-            tint,
-        });
+        self.intervals.push(Interval { start, end, label: label.into(), tint });
         self
     }
 
     /// Image size \[px\]: (width, title band + one panel height per panel).
     pub fn pixel_size(&self) -> (u32, u32) {
-        (
-            self.width,
-            TITLE_HEIGHT + self.panel_height * self.panels.len().max(1) as u32,
-        )
+        (self.width, TITLE_HEIGHT + self.panel_height * self.panels.len().max(1) as u32)
     }
 
     /// Draw to a PNG file.
     pub fn save_png(&self, path: &Path) -> Result<(), PlotError> {
         self.check(path)?;
-        draw::to_png(self, path).map_err(|message| PlotError::Draw {
-            path: path.into(),
-            message,
-        })
+        draw::to_png(self, path).map_err(|message| PlotError::Draw { path: path.into(), message })
     }
 
     /// Draw to an SVG file (text as `<text>` elements in sans-serif).
     pub fn save_svg(&self, path: &Path) -> Result<(), PlotError> {
         self.check(path)?;
-        draw::to_svg(self, path).map_err(|message| PlotError::Draw {
-            path: path.into(),
-            message,
-        })
+        draw::to_svg(self, path).map_err(|message| PlotError::Draw { path: path.into(), message })
     }
 
     /// Draw into memory: RGB8 pixels, row-major, [`Figure::pixel_size`] big.
     pub fn render_rgb(&self) -> Result<Vec<u8>, PlotError> {
         let path = Path::new("<memory>");
         self.check(path)?;
-        draw::to_rgb(self).map_err(|message| PlotError::Draw {
-            path: path.into(),
-            message,
-        })
+        draw::to_rgb(self).map_err(|message| PlotError::Draw { path: path.into(), message })
     }
 
     fn check(&self, path: &Path) -> Result<(), PlotError> {

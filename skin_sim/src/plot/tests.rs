@@ -16,18 +16,9 @@ fn paper000_run() -> Figure {
             }
         })
         .collect();
-    let speed: Vec<f64> = t
-        .iter()
-        .map(|t| 0.2 * (-t / 3.0).exp() + 0.01 * (3.0 * t).sin().abs())
-        .collect();
-    let prox: Vec<f64> = t
-        .iter()
-        .map(|t| 4.0 * (-(t - 5.0) * (t - 5.0)).exp())
-        .collect();
-    let contact: Vec<f64> = t
-        .iter()
-        .map(|&t| if (7.0..12.0).contains(&t) { 3.0 } else { 0.0 })
-        .collect();
+    let speed: Vec<f64> = t.iter().map(|t| 0.2 * (-t / 3.0).exp() + 0.01 * (3.0 * t).sin().abs()).collect();
+    let prox: Vec<f64> = t.iter().map(|t| 4.0 * (-(t - 5.0) * (t - 5.0)).exp()).collect();
+    let contact: Vec<f64> = t.iter().map(|&t| if (7.0..12.0).contains(&t) { 3.0 } else { 0.0 }).collect();
     let torque: Vec<f64> = t.iter().map(|t| 10.0 + 5.0 * (0.5 * t).cos()).collect();
     let signals = Paper000Signals {
         t: &t,
@@ -40,7 +31,7 @@ fn paper000_run() -> Figure {
         torque_norm: &torque,
         pushes: &[(14.0, 15.0)],
     };
-    paper000_figure("synthetic paper 000 run", &signals)
+    paper000_figure("synthetic intentional-contact paper run", &signals)
 }
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -71,9 +62,7 @@ fn png_has_the_expected_size_and_is_deterministic() {
 fn pixels_show_lines_text_and_shading() {
     let rgb = paper000_run().render_rgb().unwrap();
     let pixels: Vec<&[u8]> = rgb.chunks(3).collect();
-    let share = |f: &dyn Fn(&[u8]) -> bool| {
-        pixels.iter().filter(|p| f(p)).count() as f64 / pixels.len() as f64
-    };
+    let share = |f: &dyn Fn(&[u8]) -> bool| pixels.iter().filter(|p| f(p)).count() as f64 / pixels.len() as f64;
     let white = share(&|p| p.iter().all(|&c| c == 255));
     // Text, axes and thresholds; the signal lines.
     let dark = share(&|p| p.iter().all(|&c| c < 80));
@@ -104,28 +93,13 @@ fn svg_carries_the_panel_titles() {
 fn paper003_layout_reports_the_contact_rms_error() {
     let t: Vec<f64> = (0..1000).map(|k| k as f64 * 0.01).collect();
     let phase: Vec<usize> = t.iter().map(|&t| usize::from(t >= 3.0)).collect();
-    let desired: Vec<f64> = t
-        .iter()
-        .map(|&t| {
-            if t >= 3.0 {
-                5.0 + 2.0 * (t * 1.57).sin()
-            } else {
-                0.0
-            }
-        })
-        .collect();
+    let desired: Vec<f64> = t.iter().map(|&t| if t >= 3.0 { 5.0 + 2.0 * (t * 1.57).sin() } else { 0.0 }).collect();
     // Contact error alternates +-0.25 N: RMS 0.25.
     let measured: Vec<f64> = desired
         .iter()
         .zip(&phase)
         .enumerate()
-        .map(|(k, (d, &p))| {
-            d + if p == 1 {
-                0.25 * (-1f64).powi(k as i32)
-            } else {
-                0.0
-            }
-        })
+        .map(|(k, (d, &p))| d + if p == 1 { 0.25 * (-1f64).powi(k as i32) } else { 0.0 })
         .collect();
     let w: Vec<f64> = phase.iter().map(|&p| p as f64).collect();
     let base: Vec<f64> = t.iter().map(|t| 0.1 * t.sin().abs()).collect();
@@ -142,11 +116,7 @@ fn paper003_layout_reports_the_contact_rms_error() {
             interaction: &[(6.0, 7.5)],
         },
     );
-    assert!(
-        fig.panels[1].title.contains("RMS in contact 0.250 N"),
-        "{}",
-        fig.panels[1].title
-    );
+    assert!(fig.panels[1].title.contains("RMS in contact 0.250 N"), "{}", fig.panels[1].title);
     assert!(fig.render_rgb().unwrap().iter().any(|&c| c != 255));
 }
 
@@ -167,7 +137,10 @@ fn the_guidance_figure_has_paper_003_fig_6_panels() {
     };
     let fig = guidance_figure("synthetic guidance", &signals);
     let titles: Vec<&str> = fig.panels.iter().map(|p| p.title.as_str()).collect();
-    assert_eq!(titles, ["(a) Hand distance to the surface", "(b) Skin moments at the hand", "(c) Hand position", "(d) Base position"]);
+    assert_eq!(
+        titles,
+        ["(a) Hand distance to the surface", "(b) Skin moments at the hand", "(c) Hand position", "(d) Base position"]
+    );
     assert!(fig.render_rgb().unwrap().iter().any(|&c| c != 255));
     // a run through the ROS graph has no moments: the panel is left out, the others keep the paper's letters
     let none = [f64::NAN; 200];
@@ -178,33 +151,16 @@ fn the_guidance_figure_has_paper_003_fig_6_panels() {
 
 #[test]
 fn mismatched_lengths_name_file_panel_and_series() {
-    let fig =
-        Figure::new("bad").panel(Panel::lines("speed", "[m/s]").line("v", &[0.0, 1.0], &[0.0]));
-    let err = fig
-        .save_png(Path::new("/tmp/out.png"))
-        .unwrap_err()
-        .to_string();
-    assert_eq!(
-        err,
-        "/tmp/out.png: panel \"speed\", series \"v\": 2 time samples but 1 values"
-    );
+    let fig = Figure::new("bad").panel(Panel::lines("speed", "[m/s]").line("v", &[0.0, 1.0], &[0.0]));
+    let err = fig.save_png(Path::new("/tmp/out.png")).unwrap_err().to_string();
+    assert_eq!(err, "/tmp/out.png: panel \"speed\", series \"v\": 2 time samples but 1 values");
     let fig = Figure::new("bad").panel(Panel::steps("mode", "", &["a"], &[0.0], &[3]));
-    assert!(matches!(
-        fig.render_rgb(),
-        Err(PlotError::Category {
-            state: 3,
-            categories: 1,
-            ..
-        })
-    ));
+    assert!(matches!(fig.render_rgb(), Err(PlotError::Category { state: 3, categories: 1, .. })));
 }
 
 #[test]
 fn intervals_end_where_the_condition_stops() {
     let t = [0.0, 1.0, 2.0, 3.0, 4.0];
-    assert_eq!(
-        intervals_where(&t, &[false, true, true, false, true]),
-        [(1.0, 3.0), (4.0, 4.0)]
-    );
+    assert_eq!(intervals_where(&t, &[false, true, true, false, true]), [(1.0, 3.0), (4.0, 4.0)]);
     assert!(intervals_where(&t, &[false; 5]).is_empty());
 }

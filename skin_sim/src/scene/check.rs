@@ -1,6 +1,8 @@
 //! Value checks of a scene file that need no robot model: every error names the dotted key.
 
-use super::spec::{BaseMotionSpec, ObjectSpec, PersonSpec, PushSpec, SceneSpec, ShapeSpec, SkinSpec, LidarSpec, ViewSpec};
+use super::spec::{
+    BaseMotionSpec, LidarSpec, ObjectSpec, PersonSpec, PushSpec, SceneSpec, ShapeSpec, SkinSpec, ViewSpec,
+};
 
 /// A rejected value: its dotted key (e.g. `objects[2].shape.box.size_m`) and why.
 #[derive(Debug, Clone, PartialEq)]
@@ -12,10 +14,7 @@ pub(crate) struct Rejected {
 pub(crate) type Checked = Result<(), Rejected>;
 
 pub(crate) fn reject(key: impl Into<String>, reason: impl Into<String>) -> Rejected {
-    Rejected {
-        key: key.into(),
-        reason: reason.into(),
-    }
+    Rejected { key: key.into(), reason: reason.into() }
 }
 
 fn positive(key: impl Into<String>, v: f64) -> Checked {
@@ -47,10 +46,7 @@ fn rate(key: &str, hz: f64, timestep_s: f64) -> Checked {
     positive(key, hz)?;
     let steps = 1.0 / (hz * timestep_s);
     if steps < 0.999_999 || (steps - steps.round()).abs() > 1e-6 {
-        return Err(reject(
-            key,
-            format!("{hz} Hz: its period must be a whole number of timestep_s ({timestep_s} s)"),
-        ));
+        return Err(reject(key, format!("{hz} Hz: its period must be a whole number of timestep_s ({timestep_s} s)")));
     }
     Ok(())
 }
@@ -120,7 +116,10 @@ pub(crate) fn check_values(spec: &SceneSpec) -> Checked {
     for (i, m) in spec.base_motions.iter().enumerate() {
         check_base_motion(&format!("base_motions[{i}]"), m)?;
         if i > 0 && m.start_s < spec.base_motions[i - 1].end_s {
-            return Err(reject(format!("base_motions[{i}].start_s"), "before the previous motion's end_s (list them in time order, not overlapping)"));
+            return Err(reject(
+                format!("base_motions[{i}].start_s"),
+                "before the previous motion's end_s (list them in time order, not overlapping)",
+            ));
         }
     }
     Ok(())
@@ -188,9 +187,7 @@ fn check_object(key: &str, o: &ObjectSpec) -> Checked {
     positive(format!("{key}.contact_time_constant_s"), o.contact_time_constant_s)?;
     let shape = format!("{key}.shape");
     match &o.shape {
-        ShapeSpec::Box { size_m } => size_m
-            .iter()
-            .try_for_each(|&s| positive(format!("{shape}.box.size_m"), s)),
+        ShapeSpec::Box { size_m } => size_m.iter().try_for_each(|&s| positive(format!("{shape}.box.size_m"), s)),
         ShapeSpec::Cylinder { radius_m, length_m } => {
             positive(format!("{shape}.cylinder.radius_m"), *radius_m)?;
             positive(format!("{shape}.cylinder.length_m"), *length_m)
@@ -200,14 +197,8 @@ fn check_object(key: &str, o: &ObjectSpec) -> Checked {
             positive(format!("{shape}.capsule.radius_m"), *radius_m)?;
             positive(format!("{shape}.capsule.length_m"), *length_m)
         }
-        ShapeSpec::Table {
-            top_m,
-            height_m,
-            leg_radius_m,
-        } => {
-            top_m
-                .iter()
-                .try_for_each(|&s| positive(format!("{shape}.table.top_m"), s))?;
+        ShapeSpec::Table { top_m, height_m, leg_radius_m } => {
+            top_m.iter().try_for_each(|&s| positive(format!("{shape}.table.top_m"), s))?;
             positive(format!("{shape}.table.leg_radius_m"), *leg_radius_m)?;
             if !(height_m.is_finite() && *height_m > top_m[2]) {
                 return Err(reject(
@@ -250,7 +241,10 @@ fn window(key: &str, start_s: f64, end_s: f64, ramp_s: f64) -> Checked {
         return Err(reject(format!("{key}.end_s"), format!("{end_s} must be after start_s")));
     }
     if 2.0 * ramp_s > end_s - start_s {
-        return Err(reject(format!("{key}.ramp_s"), format!("{ramp_s} s: the rise and the fall must fit in the window (at most half of it)")));
+        return Err(reject(
+            format!("{key}.ramp_s"),
+            format!("{ramp_s} s: the rise and the fall must fit in the window (at most half of it)"),
+        ));
     }
     Ok(())
 }

@@ -9,10 +9,10 @@ pub mod spec;
 use std::path::{Path, PathBuf};
 
 use skin_core::model::RobotModel;
+use skin_core::param_file::yaml::{self, YamlError};
 use skin_core::resolver::BASE_JOINTS;
 use skin_core::skin::layout::{ResolvedLayout, SkinLayout};
 use skin_core::skin::params::SkinParams;
-use skin_core::param_file::yaml::{self, YamlError};
 use thiserror::Error;
 
 use check::{reject, Rejected};
@@ -91,11 +91,7 @@ impl Scene {
     /// Parses and validates scene text; `source` names it in errors, `dir` anchors relative paths.
     pub fn from_yaml_str(text: &str, source: &str, dir: &Path) -> Result<Scene, SceneError> {
         let spec: SceneSpec = yaml::parse_str(text, source)?;
-        let invalid = |r: Rejected| SceneError::Invalid {
-            file: source.to_string(),
-            key: r.key,
-            reason: r.reason,
-        };
+        let invalid = |r: Rejected| SceneError::Invalid { file: source.to_string(), key: r.key, reason: r.reason };
         check::check_values(&spec).map_err(invalid)?;
         let urdf = resolve(dir, &spec.robot.urdf);
         let robot_description = std::fs::read_to_string(&urdf)
@@ -106,21 +102,16 @@ impl Scene {
         check_frames(&spec, &model).map_err(invalid)?;
         let base_moves = BASE_JOINTS.iter().filter_map(|b| model.joint_index(b)).any(|j| moving[j]);
         if !spec.base_motions.is_empty() && !base_moves {
-            return Err(invalid(reject("base_motions", "the scene's base does not move (keep the base joints in robot.joints)")));
+            return Err(invalid(reject(
+                "base_motions",
+                "the scene's base does not move (keep the base joints in robot.joints)",
+            )));
         }
         let skin = match &spec.skin {
             Some(s) => Some(load_skin(s, dir, &model).map_err(invalid)?),
             None => None,
         };
-        Ok(Scene {
-            spec,
-            file: source.to_string(),
-            model,
-            moving,
-            q0,
-            skin,
-            robot_description,
-        })
+        Ok(Scene { spec, file: source.to_string(), model, moving, q0, skin, robot_description })
     }
 
     /// Replaces the run settings (`duration_s`, `timestep_s`, `control_rate_hz`, `seed`; None
@@ -174,9 +165,9 @@ fn joint_setup(robot: &RobotSpec, model: &RobotModel) -> Result<(Vec<bool>, Vec<
     let n = model.nv();
     let mut moving = vec![robot.joints.is_none(); n];
     for (i, name) in robot.joints.iter().flatten().enumerate() {
-        let j = model
-            .joint_index(name)
-            .ok_or_else(|| reject(format!("robot.joints[{i}]"), format!("`{name}` is not a moving joint of the URDF")))?;
+        let j = model.joint_index(name).ok_or_else(|| {
+            reject(format!("robot.joints[{i}]"), format!("`{name}` is not a moving joint of the URDF"))
+        })?;
         moving[j] = true;
     }
     let base: Vec<usize> = BASE_JOINTS.iter().filter_map(|b| model.joint_index(b)).collect();
@@ -186,9 +177,7 @@ fn joint_setup(robot: &RobotSpec, model: &RobotModel) -> Result<(Vec<bool>, Vec<
     let mut q0 = vec![0.0; n];
     for (name, &q) in &robot.initial {
         let key = format!("robot.initial.{name}");
-        let j = model
-            .joint_index(name)
-            .ok_or_else(|| reject(&key, "not a moving joint of the URDF"))?;
+        let j = model.joint_index(name).ok_or_else(|| reject(&key, "not a moving joint of the URDF"))?;
         let lim = model.joint_limits()[j];
         if q < lim.lower || q > lim.upper {
             return Err(reject(key, format!("{q} outside the joint limits [{}, {}]", lim.lower, lim.upper)));

@@ -33,7 +33,7 @@ pub struct SceneSpec {
     /// Contact force references for the controller (data only).
     #[serde(default)]
     pub force_references: Vec<ForceReferenceSpec>,
-    /// Commanded base motions for the controller (paper 003 Exp. 1), relative to the base pose
+    /// Commanded base motions for the controller (interactive-force-control paper Exp. 1), relative to the base pose
     /// at the first one's start; they count as interaction periods of the metrics.
     #[serde(default)]
     pub base_motions: Vec<BaseMotionSpec>,
@@ -42,7 +42,7 @@ pub struct SceneSpec {
     /// MuJoCo integration step \[s\]; every other period is a multiple of it.
     #[serde(default = "default_timestep")]
     pub timestep_s: f64,
-    /// Rate of the arm velocity commands \[Hz\] (TOMM's UR5: 125 Hz, paper 003 Sec. 4.1).
+    /// Rate of the arm velocity commands \[Hz\] (TOMM's UR5: 125 Hz, interactive-force-control paper Sec. 4.1).
     #[serde(default = "default_control_rate")]
     pub control_rate_hz: f64,
     /// Height of the floor plane \[m\].
@@ -113,7 +113,7 @@ pub struct SkinSpec {
     /// Ids of the patches that sense (none: all); cells of other patches read 0.
     #[serde(default)]
     pub patches: Option<Vec<u32>>,
-    /// Sample rate \[Hz\] (paper 003 Sec. 4.1: 250 Hz).
+    /// Sample rate \[Hz\] (interactive-force-control paper Sec. 4.1: 250 Hz).
     #[serde(default = "default_skin_rate")]
     pub rate_hz: f64,
     /// A contact that presses no cell's face (a corner or an edge between the faces' sample
@@ -335,7 +335,7 @@ pub struct WaypointSpec {
     pub xy_m: [f64; 2],
 }
 
-/// A goal of an end-effector frame from a start time on (paper 000 eq. (7)-(9)).
+/// A goal of an end-effector frame from a start time on (intentional-contact paper eq. (7)-(9)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GoalSpec {
@@ -352,7 +352,7 @@ pub struct GoalSpec {
 }
 
 /// A contact force reference from a start time on: `mean + amplitude sin(2 pi (t - start) / period)`
-/// (paper 003 Exp. 1, 3: sinusoids; Exp. 4: constant).
+/// (interactive-force-control paper Exp. 1, 3: sinusoids; Exp. 4: constant).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ForceReferenceSpec {
@@ -369,7 +369,7 @@ pub struct ForceReferenceSpec {
     pub period_s: Option<f64>,
 }
 
-/// A commanded base motion during `[start_s, end_s)` (paper 003 Exp. 1: a circle, then lateral
+/// A commanded base motion during `[start_s, end_s)` (interactive-force-control paper Exp. 1: a circle, then lateral
 /// swings), an offset of the base's x, y from the pose the base had when the first motion
 /// started (its yaw is held). The offset's size is faded in over `ramp_s` after the start and
 /// out over `ramp_s` before the end (a C¹ smoothstep), so the commanded position and velocity

@@ -90,12 +90,12 @@ pub struct Recommendation<'a> {
 /// simulated: with fewer cells the arm sees less of an obstacle and may reach its goal more
 /// directly, which the goal error would reward. Densities are measured, not recommended.
 pub fn recommend<'a>(candidates: &[Candidate<'a>]) -> Option<Recommendation<'a>> {
-    let full: Vec<Candidate> = candidates.iter().filter(|c| c.result.point.setting.density == Density::Full).copied().collect();
+    let full: Vec<Candidate> =
+        candidates.iter().filter(|c| c.result.point.setting.density == Density::Full).copied().collect();
     let candidates = &full[..];
     let best = candidates.iter().map(|c| c.error).fold(f64::INFINITY, f64::min);
-    let cheapest_within = |limit: f64| {
-        candidates.iter().filter(|c| c.error <= limit).min_by(|a, b| a.cost.total_cmp(&b.cost)).copied()
-    };
+    let cheapest_within =
+        |limit: f64| candidates.iter().filter(|c| c.error <= limit).min_by(|a, b| a.cost.total_cmp(&b.cost)).copied();
     let resolution = candidates.first()?.resolution;
     let accurate = cheapest_within((best * (1.0 + ACCURATE_MARGIN)).max(best + resolution))?;
     let preview = cheapest_within((accurate.error * PREVIEW_FACTOR).max(accurate.error + resolution))?;

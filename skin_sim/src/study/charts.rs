@@ -37,7 +37,8 @@ pub fn error_name(points: &[&PointResult]) -> &'static str {
 
 /// A log axis range around `values` (positive ones), padded.
 fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
-    let (lo, hi) = values.filter(|v| *v > 0.0 && v.is_finite()).fold((f64::INFINITY, 0.0_f64), |(l, h), v| (l.min(v), h.max(v)));
+    let (lo, hi) =
+        values.filter(|v| *v > 0.0 && v.is_finite()).fold((f64::INFINITY, 0.0_f64), |(l, h), v| (l.min(v), h.max(v)));
     if lo > hi {
         return 0.1..10.0;
     }
@@ -92,11 +93,15 @@ pub fn pareto(points: &[&PointResult], path: &Path) -> anyhow::Result<()> {
             .label(axis.name())
             .legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled()));
         chart
-            .draw_series(of_axis.iter().filter(|p| !stable(p)).map(|p| Cross::new((p.1, p.2), 6, colour.stroke_width(2))))
+            .draw_series(
+                of_axis.iter().filter(|p| !stable(p)).map(|p| Cross::new((p.1, p.2), 6, colour.stroke_width(2))),
+            )
             .map_err(err)?;
     }
     chart
-        .draw_series(plotted.iter().filter(|p| p.0.point.baseline).map(|p| Circle::new((p.1, p.2), 9, BLACK.stroke_width(1))))
+        .draw_series(
+            plotted.iter().filter(|p| p.0.point.baseline).map(|p| Circle::new((p.1, p.2), 9, BLACK.stroke_width(1))),
+        )
         .map_err(err)?
         .label("scenario's own setting (ringed); x: unstable")
         .legend(|(x, y)| Circle::new((x + 10, y), 7, BLACK.stroke_width(1)));
@@ -132,8 +137,10 @@ const ROW: u32 = 17;
 pub fn stability(points: &[PointResult], path: &Path) -> anyhow::Result<()> {
     font().map_err(err)?;
     let scenarios = analysis::scenarios(points);
-    let ran: Vec<Vec<&PointResult>> =
-        scenarios.iter().map(|s| analysis::of(points, s).into_iter().filter(|p| p.figures().is_some()).collect()).collect();
+    let ran: Vec<Vec<&PointResult>> = scenarios
+        .iter()
+        .map(|s| analysis::of(points, s).into_iter().filter(|p| p.figures().is_some()).collect())
+        .collect();
     let heights: Vec<u32> = ran.iter().map(|r| 70 + ROW * r.len() as u32).collect();
     let root = BitMapBackend::new(path, (1000, heights.iter().sum::<u32>().max(100))).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
@@ -150,7 +157,9 @@ pub fn stability(points: &[PointResult], path: &Path) -> anyhow::Result<()> {
             .y_label_area_size(330)
             .build_cartesian_2d(0.0..end.max(1e-3), -0.5..rows.len() as f64 - 0.5)
             .map_err(err)?;
-        let label = |v: &f64| labels.get(v.round() as usize).filter(|_| (v - v.round()).abs() < 1e-6).cloned().unwrap_or_default();
+        let label = |v: &f64| {
+            labels.get(v.round() as usize).filter(|_| (v - v.round()).abs() < 1e-6).cloned().unwrap_or_default()
+        };
         chart
             .configure_mesh()
             .disable_y_mesh()

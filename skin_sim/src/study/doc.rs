@@ -45,7 +45,8 @@ pub fn write(results: &StudyResults, results_file: &Path, doc: &Path) -> anyhow:
     let mut files = Vec::new();
     for scenario in analysis::scenarios(&results.points) {
         let path = images.join(format!("pareto_{scenario}.png"));
-        charts::pareto(&analysis::of(&results.points, scenario), &path).with_context(|| format!("drawing {}", path.display()))?;
+        charts::pareto(&analysis::of(&results.points, scenario), &path)
+            .with_context(|| format!("drawing {}", path.display()))?;
         files.push(path);
     }
     let path = images.join("stability.png");
@@ -227,21 +228,35 @@ fn pareto_section(s: &mut String, r: &StudyResults, images: &str) {
         let _ = writeln!(s, "![{scenario}]({images}/pareto_{scenario}.png)\n");
         let front = analysis::pareto(&analysis::candidates(&points));
         let items = list(front.iter().map(|c| format!("{} ({:.3} s/s, {})", setting_cell(c), c.cost, sig(c.error))));
-        let _ = writeln!(s, "Front of `{scenario}` ({}), cheapest first: {}.\n", charts::error_name(&points), if items.is_empty() { "none".into() } else { items });
+        let _ = writeln!(
+            s,
+            "Front of `{scenario}` ({}), cheapest first: {}.\n",
+            charts::error_name(&points),
+            if items.is_empty() { "none".into() } else { items }
+        );
     }
 }
 
 fn stability_section(s: &mut String, r: &StudyResults, images: &str) {
     let _ = writeln!(s, "## Where settings become unstable\n");
     let _ = writeln!(s, "![stability]({images}/stability.png)\n");
-    let unstable: Vec<&PointResult> = r.points.iter().filter(|p| p.figures().is_some_and(|f| f.unstable.is_some())).collect();
+    let unstable: Vec<&PointResult> =
+        r.points.iter().filter(|p| p.figures().is_some_and(|f| f.unstable.is_some())).collect();
     if unstable.is_empty() {
         let _ = writeln!(s, "No point went unstable.\n");
     } else {
         let _ = writeln!(s, "| scenario | setting | unstable at | criterion | detail |\n|---|---|---|---|---|");
         for p in unstable {
             let u = p.figures().and_then(|f| f.unstable.as_ref()).expect("filtered");
-            let _ = writeln!(s, "| `{}` | {} | {:.2} s | {} | {} |", p.point.scenario, p.point.setting.label(), u.t_s, u.kind.name(), u.detail);
+            let _ = writeln!(
+                s,
+                "| `{}` | {} | {:.2} s | {} | {} |",
+                p.point.scenario,
+                p.point.setting.label(),
+                u.t_s,
+                u.kind.name(),
+                u.detail
+            );
         }
         let _ = writeln!(s);
     }
@@ -254,7 +269,9 @@ fn stability_section(s: &mut String, r: &StudyResults, images: &str) {
                 let reason = reason.replace(concat!(env!("CARGO_MANIFEST_DIR"), "/../"), "");
                 Some(format!("- `{}` {}: skipped, {reason}", p.point.scenario, p.point.setting.label()))
             }
-            Outcome::Failed { error } => Some(format!("- `{}` {}: **failed**, {error}", p.point.scenario, p.point.setting.label())),
+            Outcome::Failed { error } => {
+                Some(format!("- `{}` {}: **failed**, {error}", p.point.scenario, p.point.setting.label()))
+            }
             Outcome::Ran { .. } => None,
         })
         .collect();
@@ -319,7 +336,12 @@ fn closing_note(s: &mut String, r: &StudyResults) {
         let lo = cost_at(&points, &Setting { control_rate_hz: rates.0, ..base });
         let hi = cost_at(&points, &Setting { control_rate_hz: rates.1, ..base });
         if let (Some(lo), Some(hi)) = (lo, hi) {
-            facts.push(format!("{} → {} Hz costs {:.1}× the CPU time ({lo:.3} → {hi:.3} s/s)", rates.0, rates.1, hi / lo));
+            facts.push(format!(
+                "{} → {} Hz costs {:.1}× the CPU time ({lo:.3} → {hi:.3} s/s)",
+                rates.0,
+                rates.1,
+                hi / lo
+            ));
         }
         let steps = (grid::TIMESTEPS_S[3], grid::TIMESTEPS_S[0]);
         let coarse = cost_at(&points, &Setting { timestep_s: steps.0, ..base });
@@ -327,7 +349,13 @@ fn closing_note(s: &mut String, r: &StudyResults) {
         if let (Some(c), Some(f)) = (coarse, fine) {
             facts.push(format!("a {} ms instead of a {} ms step costs {:.1}×", steps.1 * 1e3, steps.0 * 1e3, f / c));
         }
-        let cycle = |d| points.iter().find(|p| p.point.setting == Setting { density: d, ..base }).and_then(|p| p.figures()).map(|f| f.control_cycle_us_p50);
+        let cycle = |d| {
+            points
+                .iter()
+                .find(|p| p.point.setting == Setting { density: d, ..base })
+                .and_then(|p| p.figures())
+                .map(|f| f.control_cycle_us_p50)
+        };
         if let (Some(full), Some(one)) = (cycle(grid::Density::Full), cycle(grid::Density::PerPatch)) {
             facts.push(format!("one cell per patch cuts the controller cycle from {full:.0} to {one:.0} µs"));
         }

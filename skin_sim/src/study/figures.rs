@@ -18,7 +18,7 @@ pub struct Figures {
     /// CPU time of the run's thread per simulated second, set-up included \[s/s\] (None: not
     /// measurable here). Other load on the machine does not inflate it.
     pub cpu_s_per_sim_s: Option<f64>,
-    /// RMS force-tracking error in the settled contact phase (paper 003 Table 3) \[N\].
+    /// RMS force-tracking error in the settled contact phase (interactive-force-control paper Table 3) \[N\].
     pub rms_force_error_n: Option<f64>,
     /// First time the goal error was within the supervisor's tolerance \[s\].
     pub goal_reached_s: Option<f64>,

@@ -132,7 +132,7 @@ pub struct StudyScenario {
     pub duration_s: f64,
 }
 
-/// The default study: one paper 000 scenario per robot and one paper 003 force scenario, with
+/// The default study: one intentional-contact paper scenario per robot and one interactive-force-control paper force scenario, with
 /// durations that keep `make study` within minutes.
 pub const DEFAULT_SCENARIOS: [(&str, f64); 3] =
     [("intentional_contact", 20.0), ("tomm_movable_obstacles", 30.0), ("force_tracking_base_motion", 20.0)];
@@ -153,9 +153,11 @@ pub fn baseline(target: &RunTarget) -> anyhow::Result<Setting> {
 /// The inverse settings of the grid: the baseline's, then each damping and each threshold pair.
 fn inverses(base: InverseParams) -> Vec<InverseParams> {
     let dampings = DAMPINGS.iter().map(|&damping| InverseParams { damping, ..base });
-    let thresholds = RANK_THRESHOLDS
-        .iter()
-        .map(|&(rank_threshold_rel, rank_threshold_abs)| InverseParams { rank_threshold_rel, rank_threshold_abs, ..base });
+    let thresholds = RANK_THRESHOLDS.iter().map(|&(rank_threshold_rel, rank_threshold_abs)| InverseParams {
+        rank_threshold_rel,
+        rank_threshold_abs,
+        ..base
+    });
     let mut out = vec![base];
     for i in dampings.chain(thresholds) {
         if !out.contains(&i) {

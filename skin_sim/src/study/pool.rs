@@ -6,7 +6,12 @@ use std::sync::mpsc;
 
 /// `f` over every item on `jobs` threads (at least one); `done(item index, result)` is called on
 /// the calling thread as each finishes. Results in item order.
-pub fn map<T: Sync, R: Send>(items: &[T], jobs: usize, f: impl Fn(usize, &T) -> R + Sync, mut done: impl FnMut(usize, &R)) -> Vec<R> {
+pub fn map<T: Sync, R: Send>(
+    items: &[T],
+    jobs: usize,
+    f: impl Fn(usize, &T) -> R + Sync,
+    mut done: impl FnMut(usize, &R),
+) -> Vec<R> {
     let next = AtomicUsize::new(0);
     let (tx, rx) = mpsc::channel();
     let mut out: Vec<Option<R>> = items.iter().map(|_| None).collect();

@@ -77,7 +77,13 @@ pub struct Instability {
 /// The first instability of `record`, or None. `speed_limits` are the velocity limits of the
 /// model joints (model order, the order of `q` and `qd`).
 pub fn detect(record: &RunRecord, speed_limits: &[f64]) -> Option<Instability> {
-    let found = [fault(record), jump(record, speed_limits), speed(record, speed_limits), chatter(record, speed_limits), force(record)];
+    let found = [
+        fault(record),
+        jump(record, speed_limits),
+        speed(record, speed_limits),
+        chatter(record, speed_limits),
+        force(record),
+    ];
     found.into_iter().flatten().min_by(|a, b| a.t_s.total_cmp(&b.t_s))
 }
 
@@ -144,7 +150,10 @@ fn chatter(record: &RunRecord, limits: &[f64]) -> Option<Instability> {
             let reversal: Vec<bool> = cycles
                 .windows(3)
                 .map(|w| {
-                    let (d0, d1) = (w[1].joint_velocities[a] - w[0].joint_velocities[a], w[2].joint_velocities[a] - w[1].joint_velocities[a]);
+                    let (d0, d1) = (
+                        w[1].joint_velocities[a] - w[0].joint_velocities[a],
+                        w[2].joint_velocities[a] - w[1].joint_velocities[a],
+                    );
                     d0 * d1 < 0.0 && d0.abs() > step && d1.abs() > step
                 })
                 .collect();
@@ -165,7 +174,9 @@ fn chatter(record: &RunRecord, limits: &[f64]) -> Option<Instability> {
 }
 
 fn force(record: &RunRecord) -> Option<Instability> {
-    record.cycles.iter().find(|c| c.link_force_n > FORCE_BLOWUP_N).map(|c| {
-        at(c.t_s, InstabilityKind::ForceBlowup, format!("{:.0} N on one link", c.link_force_n))
-    })
+    record
+        .cycles
+        .iter()
+        .find(|c| c.link_force_n > FORCE_BLOWUP_N)
+        .map(|c| at(c.t_s, InstabilityKind::ForceBlowup, format!("{:.0} N on one link", c.link_force_n)))
 }

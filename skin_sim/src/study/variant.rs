@@ -12,9 +12,9 @@ use serde::{Deserialize, Serialize};
 use skin_core::controller::ControllerSetup;
 use skin_core::skin::layout::SkinLayout;
 
-use super::{cpu_time, density};
 use super::figures::{self, Figures};
 use super::grid::Point;
+use super::{cpu_time, density};
 use crate::runner::RunTarget;
 use crate::scene::{RunOverrides, Scene, SceneSpec};
 
@@ -95,12 +95,19 @@ fn write_variant(target: &RunTarget, point: &Point, id: usize, work: &Path) -> a
     }
     let layout = density::reduce(&SkinLayout::load(&dir.join(&setup.skin_layout))?, point.setting.density);
     let layout_file = work.join(format!("p{id:03}.layout.yaml"));
-    let header = format!("{} at density {} (skin_sim sweep)", setup.skin_layout.display(), point.setting.density.name());
-    std::fs::write(&layout_file, layout.to_yaml(&header)).with_context(|| format!("writing {}", layout_file.display()))?;
+    let header =
+        format!("{} at density {} (skin_sim sweep)", setup.skin_layout.display(), point.setting.density.name());
+    std::fs::write(&layout_file, layout.to_yaml(&header))
+        .with_context(|| format!("writing {}", layout_file.display()))?;
     setup.skin_layout = layout_file.canonicalize()?;
     setup.inverse = point.setting.inverse;
     let setup_file = work.join(format!("p{id:03}.controller.yaml"));
-    let text = format!("# {} with the study point's layout and inverse ({})\n{}", source, point.setting.label(), serde_saphyr::to_string(&setup)?);
+    let text = format!(
+        "# {} with the study point's layout and inverse ({})\n{}",
+        source,
+        point.setting.label(),
+        serde_saphyr::to_string(&setup)?
+    );
     std::fs::write(&setup_file, text).with_context(|| format!("writing {}", setup_file.display()))?;
     Ok((setup_file, layout))
 }

@@ -5,8 +5,8 @@ use anyhow::{Context as _, Result};
 use clap::Parser;
 use futures::executor::LocalPool;
 use skin_control::nodes::{self, Pass};
-use skin_sim_ros::mujoco_sim;
 use skin_control::shutdown;
+use skin_sim_ros::mujoco_sim;
 
 /// MuJoCo simulation of a scene: publishes /clock, /joint_states, /base/odom, /scan,
 /// /skin/cells, the scene's /goal and /hand_force_reference; applies

@@ -9,8 +9,8 @@ use clap::Parser;
 use futures::executor::LocalPool;
 use r2r::{Parameter, ParameterValue};
 use skin_control::nodes::{self, priority_supervisor, task_controller, Pass};
-use skin_sim_ros::mujoco_sim;
 use skin_control::shutdown;
+use skin_sim_ros::mujoco_sim;
 
 /// The skin control graph in one process: task_controller + priority_supervisor (+ mujoco_sim
 /// with --scene). Topics, services and parameters are those of the separate nodes (docs/ros.md);
@@ -104,14 +104,22 @@ fn run() -> Result<Option<bool>> {
     }
     let tc = task_controller::start(&mut tc_node, &spawner, task_controller::Options { setup: args.setup.clone() })?;
     let mut sup_node = r2r::Node::create(ctx, priority_supervisor::NODE, "")?;
-    let sup = priority_supervisor::start(&mut sup_node, &spawner, priority_supervisor::Options { setup: args.setup.clone() })?;
+    let sup = priority_supervisor::start(
+        &mut sup_node,
+        &spawner,
+        priority_supervisor::Options { setup: args.setup.clone() },
+    )?;
 
     let mut failure = None;
     {
         let mut tc_poll = || {
             let cycles = tc.counts().0;
             tc.poll();
-            if tc.counts().0 == cycles { Pass::Idle } else { Pass::Busy }
+            if tc.counts().0 == cycles {
+                Pass::Idle
+            } else {
+                Pass::Busy
+            }
         };
         let mut sup_poll = || Pass::Idle;
         let mut sim_poll = || match sim.as_mut().map(|s| s.poll()) {
@@ -122,7 +130,8 @@ fn run() -> Result<Option<bool>> {
                 Pass::Done
             }
         };
-        let mut all: Vec<(&mut r2r::Node, &mut dyn FnMut() -> Pass)> = vec![(&mut tc_node, &mut tc_poll), (&mut sup_node, &mut sup_poll)];
+        let mut all: Vec<(&mut r2r::Node, &mut dyn FnMut() -> Pass)> =
+            vec![(&mut tc_node, &mut tc_poll), (&mut sup_node, &mut sup_poll)];
         if let Some(n) = sim_node.as_mut() {
             all.push((n, &mut sim_poll));
         }

@@ -80,7 +80,9 @@ impl Schedule {
         if !forces.is_empty() {
             let reject = |reason: &str| ScheduleError { key: "force_references".into(), reason: reason.into() };
             if controller.supervisor().policy() != Policy::Phases {
-                return Err(reject("need a controller with `policy: phases` (interactive-force-control paper Table 1)"));
+                return Err(reject(
+                    "need a controller with `policy: phases` (interactive-force-control paper Table 1)",
+                ));
             }
             if map.is_none() {
                 return Err(reject(

@@ -47,7 +47,13 @@ fn main() -> Result<()> {
         anyhow::bail!("{why}");
     }
     handle.stop();
-    // Let the zero commands leave before the node goes away.
+    // The zeros are the last word: sent twice more, 30 ms apart, so that one lost sample (a loaded
+    // host; a reader that is best effort) does not leave a driver on its last velocity; then let
+    // them leave before the node goes away.
+    for _ in 0..2 {
+        node.spin_once(std::time::Duration::from_millis(30));
+        handle.send_zeros();
+    }
     node.spin_once(std::time::Duration::from_millis(50));
     Ok(())
 }

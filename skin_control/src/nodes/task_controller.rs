@@ -304,14 +304,21 @@ pub struct TaskControllerHandle {
 }
 
 impl TaskControllerHandle {
-    /// Zero commands on every command topic (unless another controller commands them), then the
-    /// summary in the log.
-    pub fn stop(&self) {
+    /// Zero commands on every command topic (and a heartbeat): a stopping controller's last word
+    /// (unless another controller commands them).
+    pub fn send_zeros(&self) {
         let mut s = self.shared.borrow_mut();
         if let Command::Listening(_) = s.command {
             s.command = Command::Active; // nobody else was heard: the zeros are ours to send
         }
         s.publish(|tc| tc.zero_outputs());
+    }
+
+    /// Zero commands on every command topic (unless another controller commands them), then the
+    /// summary in the log.
+    pub fn stop(&self) {
+        self.send_zeros();
+        let s = self.shared.borrow();
         let (cycles, faults) = s.tc.counts();
         r2r::log_info!(
             &s.logger,

@@ -174,7 +174,7 @@ impl TaskControllerParams {
             scan_timeout_s: 0.25,
             max_stamp_lead_s: 0.02,
             autostart: true,
-            commander_wait_s: 3.0,
+            commander_wait_s: 5.0,
             arms,
             skin: config.skin,
             tasks: config.tasks.clone(),

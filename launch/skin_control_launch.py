@@ -74,9 +74,9 @@ def mounted_description(urdf_text):
     return ET.tostring(root, encoding="unicode")
 
 
-def graph_nodes(namespace, description, sim_time, trigger="timer", controller=None, watchdog=None):
-    """task_controller (with the parameters `controller` on top; activated at start when the
-    launch argument `autostart` is true), skin_watchdog in timer mode (arguments `watchdog`, by
+def graph_nodes(namespace, description, sim_time, autostart, trigger="timer", controller=None, watchdog=None):
+    """task_controller (with the parameters `controller` on top; activated at start when
+    `autostart` is "true"), skin_watchdog in timer mode (arguments `watchdog`, by
     default the command topics the controller's heartbeat names), priority_supervisor,
     skin_aggregator for `description` (a describe() result), robot_state_publisher and RViz when
     the launch arguments `robot_state_publisher` and `rviz` say so; every node but RViz in
@@ -84,7 +84,6 @@ def graph_nodes(namespace, description, sim_time, trigger="timer", controller=No
     setup = description["setup"]
     time = {"use_sim_time": sim_time}
     urdf_text = open(description["urdf"]).read()
-    autostart = ParameterValue(LaunchConfiguration("autostart"), value_type=bool)
     # Zeros on the command topics when the controller's heartbeat stops; not in lockstep, where
     # the simulation waits for the controller. Sim time: a wider timeout.
     guard = [] if trigger != "timer" else [
@@ -95,7 +94,7 @@ def graph_nodes(namespace, description, sim_time, trigger="timer", controller=No
              output="screen",
              parameters=[share_file("config", "ros", "task_controller.yaml"), time,
                          {"setup_file": setup, "trigger": trigger, "use_scan": description["lidar"],
-                          "autostart": autostart},
+                          "autostart": autostart == "true"},
                          controller or {}]),
         Node(package=PKG, executable="priority_supervisor", name="priority_supervisor", namespace=namespace,
              output="screen",

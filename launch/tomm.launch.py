@@ -128,7 +128,8 @@ def launch_setup(context):
     commands = {"arms.namespaces": namespaces, "arms.joint_prefixes": [a["tf_prefix"] for a in arm_list]}
     # The watchdog zeroes the arms' and the base's command topics from the start (relative: in ns).
     watchdog = [x for n in namespaces for x in ("--arm", f"{n}/forward_velocity_controller/commands=6")]
-    return robot + graph_nodes(ns, description, sim_time=sim, controller=commands,
+    autostart = arg("autostart") or ("true" if sim else "false")
+    return robot + graph_nodes(ns, description, sim_time=sim, autostart=autostart, controller=commands,
                                watchdog=watchdog + (["--timeout-s", "0.1"] if sim else []))
 
 
@@ -138,8 +139,8 @@ def generate_launch_description():
         ("scene", "tomm_movable_obstacles", "hardware:=sim: the TOMM scene to simulate"),
         ("setup", "", "controller setup file (default: config/controller/tomm.yaml; sim: the scenario's)"),
         ("namespace", "", "namespace of the whole graph"),
-        ("autostart", "false", "activate task_controller at start (else: ros2 lifecycle set <ns>/task_controller "
-                               "configure, then activate; hardware:=sim defaults to it too)"),
+        ("autostart", "", "activate task_controller at start (default: false for hardware:=real, where "
+                          "ros2 lifecycle set <ns>/task_controller configure, then activate; true for hardware:=sim)"),
         ("ur_type", "ur5", "UR type of both arms (ur_robot_driver)"),
         ("ur_description_file", "", "the UR description xacro (default: ur_robot_driver's urdf/ur.urdf.xacro)"),
         ("headless_mode", "false", "ur_robot_driver headless mode"),

@@ -172,7 +172,7 @@ def ament_prefix(tmp_path_factory):
     prefix = tmp_path_factory.mktemp("install")
     index = prefix / "share" / "ament_index" / "resource_index" / "packages"
     index.mkdir(parents=True)
-    packages = {"skin_control": (["launch", "config", "urdf"], ["task_controller", "priority_supervisor", "skin_aggregator"]),
+    packages = {"skin_control": (["launch", "config", "urdf"], ["task_controller", "skin_watchdog", "priority_supervisor", "skin_aggregator"]),
                 "skin_sim_ros": (["skin_sim_ros/launch"], ["mujoco_sim"])}
     for pkg, (dirs, exes) in packages.items():
         (index / pkg).write_text("")

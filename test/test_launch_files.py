@@ -76,4 +76,4 @@ def test_the_launch_files_start_the_watchdog_and_activate_only_the_simulation():
     tomm = ast.parse((TOP / "launch" / "tomm.launch.py").read_text())
     args = {const(t.elts[0]): const(t.elts[1]) for t in ast.walk(tomm)
             if isinstance(t, ast.Tuple) and len(t.elts) == 3 and all(const(e) is not None for e in t.elts[:2])}
-    assert args.get("autostart") == "false", args
+    assert args.get("autostart") == "", args  # launch_setup: false for hardware:=real, true for sim

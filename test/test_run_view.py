@@ -7,8 +7,9 @@ and with rosbags, as outside peers:
   kinematics of `/robot_description` at the `/joint_states` of the same instant;
 - every `/skin/markers` marker is in a frame of that tree;
 - `/robot_description` is offered transient local (RViz's robot model subscribes late).
-The picture test renders the last frame again and finds each pressed cell's marker colour at the
+The picture test renders the frame of the firmest press again and finds each pressed cell's marker colour at the
 cell's position projected through the camera, the position taken from MuJoCo's own body poses."""
+import copy
 import json
 import math
 import os
@@ -176,7 +177,7 @@ def look_at(camera, point, forward, distance=0.4):
 
 
 def test_the_pressed_cells_colour_is_where_the_cell_is(run_dir):
-    """Renders the last frame with the overlay and finds each pressed cell's (force signal > 0.3)
+    """Renders the frame of the firmest press with the overlay and finds each pressed cell's (force signal > 0.3)
     marker colour at the cell's position projected through the camera: red/green = force /
     proximity, green = blue (lighting scales the channels alike; the overlay has no highlights);
     and the patch force arrow's yellow halfway along it, seen from above. Positions come from
@@ -187,10 +188,14 @@ def test_the_pressed_cells_colour_is_where_the_cell_is(run_dir):
     import mujoco
 
     view = json.loads((run_dir / "keyframes.json").read_text())
-    shown = {}
+    # The frame of the firmest press (markers as RViz holds them after that frame's updates).
+    shown, best = {}, None
     for f in view["frames"]:
         rk.apply_updates(shown, f["markers"])
-    frame = view["frames"][-1]
+        red = max((c[0] for m in shown.values() if m["shape"] == "sphere_list" for c in m["colors"]), default=0.0)
+        if best is None or red > best[0]:
+            best = (red, f, copy.deepcopy(shown))
+    _, frame, shown = best
     pressed = [(m, p, c) for m in shown.values() if m["shape"] == "sphere_list"
                for p, c in zip(m["points"], m["colors"]) if c[0] > 0.3]
     assert pressed, "intentional_contact presses the arm on the obstacle by 10 s"

@@ -18,7 +18,7 @@ use thiserror::Error;
 
 use crate::interaction::Interactions;
 use crate::probe::ContactProbe;
-use crate::record::{mode_name, CycleRecord, RunRecord, Switch};
+use crate::record::{CycleRecord, RunRecord, Switch};
 use crate::scene::Scene;
 use crate::schedule::{Schedule, ScheduleError, ScheduledInputs};
 use crate::view::ViewRecorder;
@@ -199,7 +199,7 @@ impl ClosedLoop {
         let mut event = self.record.cycles.is_empty().then(|| "start".to_string());
         if let Some(tr) = self.controller.supervisor().last_transition() {
             self.record.switches.push(Switch { t_s: tr.t_s, from: tr.from, to: tr.to });
-            event = Some(format!("{} -> {}", mode_name(tr.from), mode_name(tr.to)));
+            event = Some(format!("{} -> {}", tr.from.name(), tr.to.name()));
         }
         self.view.cycle(&self.world, cycle.mode, event);
         let commands = &self.controller.output().commands;

@@ -6,7 +6,7 @@ use serde::Serialize;
 use skin_core::resolver::BASE_JOINTS;
 use skin_core::supervisor::Mode;
 
-use crate::record::{mode_name, CycleRecord, RunRecord};
+use crate::record::{CycleRecord, RunRecord};
 use crate::scene::Scene;
 
 /// An interaction's effect on the force outlasts it: cycles this long after one count as "with
@@ -186,7 +186,7 @@ pub fn compute(record: &RunRecord, scene: &Scene, limits: Limits) -> Metrics {
         arrangement_switches: record
             .switches
             .iter()
-            .map(|s| SwitchEntry { t: s.t_s, from: mode_name(s.from), to: mode_name(s.to) })
+            .map(|s| SwitchEntry { t: s.t_s, from: s.from.name(), to: s.to.name() })
             .collect(),
         faulted_cycles: cycles.iter().filter(|c| c.fault.is_some()).count(),
         goal: (!scene.spec.goals.is_empty()).then(|| goal_metrics(cycles, scene, limits)),

@@ -71,9 +71,6 @@ pub struct Switch {
     pub to: Mode,
 }
 
-/// Most key frames (labelled frames) one run keeps: the start, the first switches, the end.
-pub const MAX_KEY_FRAMES: usize = 8;
-
 /// A whole run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunRecord {
@@ -104,7 +101,7 @@ pub struct RunRecord {
     /// The MJCF the run simulated (primitive geoms only: self-contained).
     pub mjcf: String,
     /// What a viewer sees: frames at the view rate and the key frames (the start, the first
-    /// switches, the end; at most [`MAX_KEY_FRAMES`]).
+    /// switches, the end; at most [`crate::view::MAX_KEY_FRAMES`]).
     pub view: View,
 }
 
@@ -130,13 +127,3 @@ impl RunRecord {
     }
 }
 
-/// The name of a mode as in `config/supervisor.yaml`'s arrangements.
-pub fn mode_name(mode: Mode) -> &'static str {
-    match mode {
-        Mode::Avoidance => "avoidance",
-        Mode::IntentionalContact => "intentional_contact",
-        Mode::HardContact => "hard_contact",
-        Mode::PreContact => "precontact",
-        Mode::Contact => "contact",
-    }
-}

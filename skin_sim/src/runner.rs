@@ -13,7 +13,7 @@ use crate::interaction::Interactions;
 use crate::metrics::{self, Limits};
 use crate::outcome;
 use crate::probe::ContactProbe;
-use crate::record::{mode_name, CycleRecord, RunRecord, Switch};
+use crate::record::{CycleRecord, RunRecord, Switch};
 use crate::report::RunReport;
 use crate::scenario::{self, ForceTargets, Scenario};
 use crate::scene::{RunOverrides, Scene};
@@ -180,7 +180,7 @@ impl ExternalRun {
         let mut event = self.record.cycles.is_empty().then(|| "start".to_string());
         if let Some(last) = self.record.cycles.last().filter(|c| c.mode != decision.mode) {
             self.record.switches.push(Switch { t_s, from: last.mode, to: decision.mode });
-            event = Some(format!("{} -> {}", mode_name(last.mode), mode_name(decision.mode)));
+            event = Some(format!("{} -> {}", last.mode.name(), decision.mode.name()));
         }
         self.view.cycle(world, decision.mode, event);
         let forces = self.probe.measure(world);

@@ -13,11 +13,13 @@ use skin_core::skin::layout::ResolvedLayout;
 use skin_core::skin::markers::SkinMarkers;
 use skin_core::supervisor::Mode;
 
-use crate::record::{mode_name, MAX_KEY_FRAMES};
 use crate::scene::spec::{GoalSpec, ViewSpec};
 use crate::scene::Scene;
 use crate::world::KeyFrame;
 use crate::world::World;
+
+/// Most key frames (labelled frames) one run keeps: the start, the first switches, the end.
+pub const MAX_KEY_FRAMES: usize = 8;
 
 /// The TF frame the robot's tree hangs from: the world of the simulation, which is the
 /// odometry frame of the base (RViz's fixed frame in `config/skin.rviz`).
@@ -178,7 +180,7 @@ impl ViewRecorder {
             self.markers.update(&self.layout, readings, &self.fusion, &self.wrenches, &mut markers);
         }
         let mut frame = world.key_frame(label);
-        frame.mode = mode_name(mode).to_string();
+        frame.mode = mode.name().to_string();
         frame.poses = self.frames.iter().map(|&f| pose_array(self.data.frame_pose(f))).collect();
         frame.markers = markers;
         self.view.frames.push(frame);

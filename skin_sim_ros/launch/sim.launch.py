@@ -33,7 +33,7 @@ def launch_setup(context):
                output="screen",
                arguments=["--scene", description["scene"]]
                + (["--lockstep"] if lockstep else ["--realtime-factor", arg("realtime_factor")]))
-    return [sim] + graph_nodes(arg("namespace"), description, sim_time=True,
+    return [sim] + graph_nodes(arg("namespace"), description, sim_time=True, autostart=arg("autostart"),
                                trigger="inputs" if lockstep else "timer")
 
 

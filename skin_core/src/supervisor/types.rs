@@ -19,6 +19,19 @@ pub enum Mode {
 }
 
 impl Mode {
+    /// The mode's name as in `config/supervisor.yaml`'s arrangements.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Avoidance => "avoidance",
+            Mode::IntentionalContact => "intentional_contact",
+            Mode::HardContact => "hard_contact",
+            Mode::PreContact => "precontact",
+            Mode::Contact => "contact",
+        }
+    }
+}
+
+impl Mode {
     /// All modes, in discriminant order.
     pub const ALL: [Mode; 5] =
         [Mode::Avoidance, Mode::IntentionalContact, Mode::HardContact, Mode::PreContact, Mode::Contact];

@@ -8,7 +8,7 @@ DEPS := $(TOP)/.deps
 ENV := source $(DEPS)/env.sh &&
 MSGS_STAMP := $(DEPS)/ros/install/share/skin_msgs/package.xml
 MSG_SRCS := $(wildcard skin_msgs/msg/*.msg skin_msgs/srv/*.srv) skin_msgs/CMakeLists.txt skin_msgs/package.xml
-# tf2_msgs from ROS2_PYTHON_TOOLS (scripts/bootstrap, step 6): r2r must generate it once it is there.
+# tf2_msgs from third_party/ros2-jazzy-python (scripts/bootstrap, step 6): r2r must generate it once it is there.
 MSG_SRCS += $(wildcard $(DEPS)/ros/install/.ros2-jazzy-python.stamp)
 CARGO_PROFILE ?= dev
 

@@ -156,8 +156,8 @@ def ros2_or_skip():
     probe = exe and subprocess.run([exe, "launch", "--help"], capture_output=True).returncode == 0
     if not probe:
         pytest.skip("needs the ROS 2 Jazzy command line (`ros2 launch`): on a robot source "
-                    "/opt/ros/jazzy/setup.bash; here set ROS2_PYTHON_TOOLS to a directory with the "
-                    "upstream launch/ros2cli sources and their `install` script, then re-run scripts/bootstrap")
+                    "/opt/ros/jazzy/setup.bash; without it scripts/bootstrap installs them from "
+                    "third_party/ros2-jazzy-python (re-run it)")
     return exe
 
 

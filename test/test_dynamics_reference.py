@@ -56,6 +56,29 @@ def close(a, b):
     return float(err.max()) if err.size else 0.0
 
 
+def pinocchio_quantities(pin, m, d, qp, vp, link, point, vidx):
+    """pinocchio's M, C q' + g, g, the point Jacobian of `point` on `link` (world axes, linear part
+    at the point) and its J' q' at (qp, vp), restricted to the velocity indices `vidx`."""
+    M = pin.crba(m, d, qp)
+    M = np.triu(M) + np.triu(M, 1).T
+    b = pin.rnea(m, d, qp, vp, np.zeros(m.nv))
+    g = pin.computeGeneralizedGravity(m, d, qp)
+    pin.forwardKinematics(m, d, qp, vp, np.zeros(m.nv))
+    pin.updateFramePlacements(m, d)
+    fid = m.getFrameId(link)
+    r = d.oMf[fid].rotation @ np.asarray(point)
+    J = pin.computeFrameJacobian(m, d, qp, fid, pin.LOCAL_WORLD_ALIGNED)
+    pin.forwardKinematics(m, d, qp, vp, np.zeros(m.nv))
+    J[:3] = J[:3] - skew(r) @ J[3:]
+    acc = pin.getFrameClassicalAcceleration(m, d, fid, pin.LOCAL_WORLD_ALIGNED)
+    vel = pin.getFrameVelocity(m, d, fid, pin.LOCAL_WORLD_ALIGNED)
+    w, alpha = vel.angular, acc.angular
+    a_lin = acc.linear + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
+    ix = np.ix_(vidx, vidx)
+    return {"mass_matrix": M[ix], "bias": b[vidx], "gravity": g[vidx],
+            "jacobian": J[:, vidx], "jacobian_dot_qdot": np.concatenate([a_lin, alpha])}
+
+
 class Pinocchio:
     def __init__(self, urdf, names):
         import pinocchio as pin
@@ -70,25 +93,7 @@ class Pinocchio:
         nq = m.nq
         qp = np.zeros(nq); vp = np.zeros(m.nv)
         qp[self.qidx] = q; vp[self.vidx] = qd
-        M = pin.crba(m, d, qp); M = np.triu(M) + np.triu(M, 1).T
-        b = pin.rnea(m, d, qp, vp, np.zeros(m.nv))
-        g = pin.computeGeneralizedGravity(m, d, qp)
-        pin.forwardKinematics(m, d, qp, vp, np.zeros(m.nv))
-        pin.updateFramePlacements(m, d)
-        fid = m.getFrameId(link)
-        R = d.oMf[fid].rotation
-        r = R @ np.asarray(point)
-        J = pin.computeFrameJacobian(m, d, qp, fid, pin.LOCAL_WORLD_ALIGNED)
-        pin.forwardKinematics(m, d, qp, vp, np.zeros(m.nv))
-        Jp = J.copy()
-        Jp[:3] = J[:3] - skew(r) @ J[3:]
-        acc = pin.getFrameClassicalAcceleration(m, d, fid, pin.LOCAL_WORLD_ALIGNED)
-        vel = pin.getFrameVelocity(m, d, fid, pin.LOCAL_WORLD_ALIGNED)
-        w, alpha = vel.angular, acc.angular
-        a_lin = acc.linear + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
-        ix = np.ix_(self.vidx, self.vidx)
-        return {"mass_matrix": M[ix], "bias": b[self.vidx], "gravity": g[self.vidx],
-                "jacobian": Jp[:, self.vidx], "jacobian_dot_qdot": np.concatenate([a_lin, alpha])}
+        return pinocchio_quantities(pin, m, d, qp, vp, link, point, self.vidx)
 
 
 class Mujoco:

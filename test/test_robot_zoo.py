@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 from conftest import binary
+from test_dynamics_reference import pinocchio_quantities
 
 TOL = 1e-9
 N_STATES = 6
@@ -77,10 +78,6 @@ def run_ours(urdf, states, mimic):
     return json.loads(out.stdout), out.stderr
 
 
-def skew(v):
-    return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-
-
 class Pinocchio:
     """pinocchio on the same URDF; our coordinates are mapped to its q by joint name (continuous
     joints are (cos, sin) pairs in pinocchio's q)."""
@@ -117,24 +114,7 @@ class Pinocchio:
                 qp[i:i + 2] = np.cos(x), np.sin(x)
         vp = np.zeros(m.nv)
         vp[self.vidx] = qd
-        M = pin.crba(m, d, qp)
-        M = np.triu(M) + np.triu(M, 1).T
-        b = pin.rnea(m, d, qp, vp, np.zeros(m.nv))
-        g = pin.computeGeneralizedGravity(m, d, qp)
-        pin.forwardKinematics(m, d, qp, vp, np.zeros(m.nv))
-        pin.updateFramePlacements(m, d)
-        fid = m.getFrameId(link)
-        r = d.oMf[fid].rotation @ np.asarray(point)
-        J = pin.computeFrameJacobian(m, d, qp, fid, pin.LOCAL_WORLD_ALIGNED)
-        pin.forwardKinematics(m, d, qp, vp, np.zeros(m.nv))
-        J[:3] = J[:3] - skew(r) @ J[3:]
-        acc = pin.getFrameClassicalAcceleration(m, d, fid, pin.LOCAL_WORLD_ALIGNED)
-        vel = pin.getFrameVelocity(m, d, fid, pin.LOCAL_WORLD_ALIGNED)
-        w, alpha = vel.angular, acc.angular
-        a_lin = acc.linear + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
-        ix = np.ix_(self.vidx, self.vidx)
-        return {"mass_matrix": M[ix], "bias": b[self.vidx], "gravity": g[self.vidx],
-                "jacobian": J[:, self.vidx], "jacobian_dot_qdot": np.concatenate([a_lin, alpha])}
+        return pinocchio_quantities(pin, m, d, qp, vp, link, point, self.vidx)
 
 
 class ComposedMimic:

@@ -65,6 +65,7 @@ class Robot:
                     "scan": node.create_publisher(LaserScan, "/scan", DEEP),
                     "cells": node.create_publisher(SkinCellArray, "/skin/cells", DEEP),
                     "goal": node.create_publisher(PoseStamped, "/goal", LATCHED)}
+        self.goal, self.ticks = None, 0
         node.create_timer(0.01, self.tick)
 
     def on_arm(self, side, msg, info):
@@ -83,6 +84,7 @@ class Robot:
         goal.header.frame_id = "world"
         goal.pose.position.x, goal.pose.position.y, goal.pose.position.z = x, y, z
         goal.pose.orientation.w = 1.0
+        self.goal = goal
         self.pub["goal"].publish(goal)
 
     def joint_state(self, side, stamp_offset):
@@ -106,6 +108,11 @@ class Robot:
         self.base = [self.base[0] + (c * vx - s * vy) * dt, self.base[1] + (s * vx + c * vy) * dt, self.base[2] + wz * dt]
         if not self.streaming:
             return
+        # The goal again every 0.5 s, as an operator's tool does: controllers read goals volatile
+        # (REP 2003), so one that matched after the first send (slow discovery, a restart) gets it.
+        self.ticks += 1
+        if self.goal is not None and self.ticks % 50 == 0:
+            self.pub["goal"].publish(self.goal)
         from nav_msgs.msg import Odometry
         from sensor_msgs.msg import LaserScan
 

@@ -249,7 +249,8 @@ def test_skin_aggregator(spawn, rclpy_node):
     assert [v.double_value for v in values] == [THRESHOLD, 0.5]
     desc = peer.call(DescribeParameters, "describe_parameters",
                      DescribeParameters.Request(names=["fusion.weight_force"])).descriptors[0]
-    assert "eq. 6" in desc.description
+    # declared once in skin_core (declare_params!): description, range and run-time flag
+    assert "eq. (6)" in desc.description and "in [0, 1] (settable)" in desc.description, desc.description
 
     ok = peer.set_param("fusion.weight_force", 1.0)
     assert ok.successful, ok.reason

@@ -10,28 +10,6 @@ use crate::convert::cdr_cells::CdrCells;
 use crate::convert::{update_cells, write_patch_array, CellBuffer, CellMessage, Issue, IssueCounts};
 use crate::markers::SkinMarkers;
 
-/// `ros2 param describe` texts of the skin model parameters (`skin_core::skin::params::SkinParams`,
-/// `config/skin_model.yaml`), by dotted key.
-pub const SKIN_PARAM_DESCRIPTIONS: &[(&str, &str)] = &[
-    ("proximity.range_m", "Proximity sensing range [m]: signal 0 from here on (intentional-contact paper eq. 3 d_range)"),
-    ("proximity.decay_m", "Decay length of the proximity characteristic p(d) [m]"),
-    ("force.scale_n", "Scale of the force characteristic f(F) [N]"),
-    ("force.max_n", "Force at which the force signal saturates at 1 [N]"),
-    (
-        "fusion.weight_force",
-        "w of interactive-force-control paper eq. 6 in [0, 1]: cell virtual force sF = w f + (1 - w) p (0: proximity only, 1: force only)",
-    ),
-    (
-        "fusion.activity_threshold",
-        "A cell is active (enters the patch wrench, eq. 7-8) when sF exceeds this, in [0, 1)",
-    ),
-    ("fusion.force_reduction", "How a cell's three force sensors make one signal: mean | max"),
-    ("repulsion.gain_n_per_m", "Intentional-contact paper eq. 3 repulsion gain K [N/m]"),
-    ("repulsion.range_m", "Intentional-contact paper eq. 3 repulsion range [m], <= proximity.range_m"),
-    ("repulsion.max_force_n", "Interactive-force-control paper eq. 16 largest repulsive force [N]"),
-    ("repulsion.decay_m", "Interactive-force-control paper eq. 16 decay length [m]"),
-];
-
 /// Cells to patch wrenches and markers for one layout; every buffer is kept between messages.
 #[derive(Debug, Clone)]
 pub struct Aggregator {
@@ -114,7 +92,6 @@ impl Aggregator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ros_params::flatten;
     use r2r::skin_msgs::msg::SkinCellArray;
     use r2r::WrappedTypesupport;
     use skin_core::model::RobotModel;
@@ -124,15 +101,6 @@ mod tests {
 
     fn repo(rel: &str) -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
-    }
-
-    #[test]
-    fn every_skin_parameter_has_a_description() {
-        let p = SkinParams::load(&repo("config/skin_model.yaml")).unwrap();
-        let keys: Vec<String> = flatten(&p).unwrap().keys().cloned().collect();
-        let mut described: Vec<String> = SKIN_PARAM_DESCRIPTIONS.iter().map(|(k, _)| k.to_string()).collect();
-        described.sort();
-        assert_eq!(keys, described);
     }
 
     #[test]

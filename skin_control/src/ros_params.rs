@@ -21,6 +21,7 @@ use r2r::{Parameter, ParameterValue, RosParams};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use serde_json::{Map, Number, Value};
+use skin_core::param_file::declare::ParamSpec;
 
 /// A parameter key with what is wrong with it.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -69,6 +70,8 @@ pub struct StructParams<T> {
     flat: IndexMap<String, ParameterValue>,
     validate: Validate<T>,
     descriptions: &'static [(&'static str, &'static str)],
+    /// Descriptions from declarations (`skin_core::param_file::declare`), by dotted key.
+    declared: IndexMap<String, &'static str>,
     read_only: IndexMap<String, (ParameterValue, &'static str)>,
     start_only: &'static [&'static str],
 }
@@ -87,6 +90,7 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
             value,
             validate,
             descriptions,
+            declared: IndexMap::new(),
             read_only: IndexMap::new(),
             start_only: &[],
         })
@@ -95,6 +99,19 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
     /// Adds a read-only entry `name` (listed and readable; set requests are rejected).
     pub fn with_read_only(mut self, name: &str, value: ParameterValue, description: &'static str) -> Self {
         self.read_only.insert(name.to_string(), (value, description));
+        self
+    }
+
+    /// Describes the keys of declared parameters (`ros2 param describe`: the description, unit,
+    /// range, and whether the node applies a change while it runs).
+    pub fn with_specs(mut self, specs: Vec<ParamSpec>) -> Self {
+        for s in specs {
+            let unit = if s.unit.is_empty() { String::new() } else { format!(" [{}]", s.unit) };
+            let when = if s.live && !self.is_start_only(&s.key) { "settable" } else { "start only" };
+            // r2r takes `&'static str` descriptions: one string per parameter, made once per node
+            let text = format!("{}{unit}, in {} ({when})", s.description, s.values);
+            self.declared.insert(s.key, Box::leak(text.into_boxed_str()));
+        }
         self
     }
 
@@ -144,7 +161,8 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
     }
 
     fn description(&self, key: &str) -> &'static str {
-        self.descriptions.iter().find(|(k, _)| *k == key).map_or("", |(_, d)| d)
+        let listed = self.descriptions.iter().find(|(k, _)| *k == key).map(|(_, d)| *d);
+        listed.or_else(|| self.declared.get(key).copied()).unwrap_or("")
     }
 
     /// Lays the node's parameter overrides (name -> value, as r2r reads them from `--ros-args`)

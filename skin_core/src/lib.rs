@@ -44,6 +44,7 @@ pub mod controller;
 pub mod hierarchy;
 pub mod model;
 pub mod param_file;
+pub mod params_doc;
 pub mod resolver;
 pub mod skin;
 pub mod supervisor;

@@ -9,7 +9,7 @@ use futures::{executor::LocalPool, task::LocalSpawnExt, StreamExt};
 use r2r::skin_msgs::msg::PatchWrenchArray;
 use r2r::visualization_msgs::msg::MarkerArray;
 use r2r::{ParameterValue, RosParams};
-use skin_control::aggregator::{Aggregator, SKIN_PARAM_DESCRIPTIONS};
+use skin_control::aggregator::Aggregator;
 use skin_control::convert::{patch_frame_id, IssueKind};
 use skin_control::nodes::topics::{CELLS as CELLS_TOPIC, MARKERS as MARKERS_TOPIC, PATCHES as PATCHES_TOPIC};
 use skin_control::nodes::{self, file_setting, resolve};
@@ -17,6 +17,7 @@ use skin_control::ros_params::StructParams;
 use skin_control::tf::{FrameTransform, TfPublisher};
 use skin_control::{markers, qos, shutdown};
 use skin_core::model::RobotModel;
+use skin_core::param_file::declare::Declared;
 use skin_core::skin::layout::{ResolvedLayout, SkinLayout};
 use skin_core::skin::params::SkinParams;
 
@@ -62,7 +63,8 @@ fn setup(node: &r2r::Node, args: Args) -> Result<Setup> {
     let model = RobotModel::from_urdf_file(&resolve(&urdf, "urdf_file")?)?;
     let layout = SkinLayout::load(&resolve(&layout_file, "layout_file")?)?.resolve(&model)?;
     let defaults = SkinParams::load(&resolve(&skin_model, "skin_model_file")?)?;
-    let mut params = StructParams::new(defaults, |p| p.validate().map_err(|e| e.to_string()), SKIN_PARAM_DESCRIPTIONS)?
+    let mut params = StructParams::new(defaults, |p| p.validate().map_err(|e| e.to_string()), &[])?
+        .with_specs(SkinParams::all_specs())
         .with_read_only("urdf_file", ParameterValue::String(urdf), "Robot URDF (read at start)")
         .with_read_only("layout_file", ParameterValue::String(layout_file), "Skin layout (read at start)")
         .with_read_only(

@@ -11,7 +11,7 @@ use r2r::builtin_interfaces::msg::Time;
 use r2r::geometry_msgs::msg::Twist;
 use r2r::skin_msgs::msg::{Arrangement as ArrangementMsg, ControllerState, TaskState};
 use r2r::std_msgs::msg::{Float64MultiArray, MultiArrayDimension};
-use skin_core::controller::{ControllerOutput, TaskKind};
+use skin_core::controller::ControllerOutput;
 use skin_core::hierarchy::LevelDiagnostics;
 use skin_core::supervisor::{Arrangement, Imposed, Mode};
 
@@ -160,7 +160,7 @@ pub fn write_controller_state(
     for (p, &i) in order.iter().enumerate() {
         let state = &mut msg.tasks[i];
         state.priority = p as u32 + 1;
-        if TaskKind::from_name(&tasks[i]).is_some_and(TaskKind::is_level) {
+        if skin_core::tasks::lookup(&tasks[i]).is_some_and(|e| e.role.is_level()) {
             if let Some(d) = level.next() {
                 state.torque_norm = d.torque_norm;
                 state.error_norm = d.task_error.unwrap_or(0.0);

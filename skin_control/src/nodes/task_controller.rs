@@ -16,6 +16,9 @@ use r2r::skin_msgs::msg::{Arrangement, ControllerState};
 use r2r::std_msgs::msg::{Float64, Float64MultiArray, Header};
 use r2r::{ParameterValue, RosParams};
 use skin_core::controller::ControllerConfig;
+use skin_core::param_file::declare::{Declared, ParamSpec};
+use skin_core::skin::params::SkinParams;
+use skin_core::tasks::params::TaskParams;
 
 use super::topics::*;
 use super::{file_setting, local, resolve, resolved, ros_now, OnceLog, Timing};
@@ -440,6 +443,14 @@ fn serve_lifecycle(
     Ok(())
 }
 
+/// The declared skin model and task parameters under their `skin.` and `tasks.` prefixes.
+fn declared_specs() -> Vec<ParamSpec> {
+    let mut specs = Vec::new();
+    SkinParams::specs("skin.", &mut specs);
+    TaskParams::specs("tasks.", &mut specs);
+    specs
+}
+
 /// Creates the node's parameters, subscriptions, publishers and timer, and spawns its tasks.
 pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> Result<TaskControllerHandle> {
     let logger = node.logger().to_string();
@@ -448,6 +459,7 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     let mut params =
         StructParams::new(TaskControllerParams::defaults(&config), TaskControllerParams::validate, DESCRIPTIONS)?
             .with_start_only(START_ONLY)
+            .with_specs(declared_specs())
             .with_read_only(
                 "setup_file",
                 ParameterValue::String(setup.clone()),

@@ -4,7 +4,7 @@ use nalgebra::{DMatrix, DVector, Isometry3};
 
 use super::io::{ControllerInput, ControllerOutput, Fault};
 use super::setup::{ControllerConfig, HierarchyDynamics, SetupError};
-use super::task_set::{CycleContext, HandSignals, TaskSet};
+use super::task_set::TaskSet;
 use crate::hierarchy::{HierarchySolver, LevelDiagnostics};
 use crate::model::{gravity, point_velocity, update_kinematics, ModelData};
 use crate::resolver::{Commands, Resolver};
@@ -13,7 +13,10 @@ use crate::skin::live::LiveCells;
 use crate::skin::transforms::{patch_poses_world, patch_wrench_world, sum_patch_forces_in_frame};
 use crate::supervisor::blend::chi;
 use crate::supervisor::{Arrangement, Imposed, Phase, PhaseRefused, Supervisor, SupervisorInput, TorqueBlender};
+use crate::tasks::avoidance::ProximityAvoidance;
+use crate::tasks::contact_reaction::ContactReaction;
 use crate::tasks::posture::BaseReference;
+use crate::tasks::{Cycle, HandSignals, TaskEntry, TaskSetup};
 
 /// Maps a stage's error to [`Fault::Stage`] (the error's text would allocate).
 fn stage<E>(name: &'static str) -> impl FnOnce(E) -> Fault {
@@ -40,11 +43,18 @@ fn stage<E>(name: &'static str) -> impl FnOnce(E) -> Fault {
 /// acceleration limits, from the first cycle on: a measured velocity never sets a command (one
 /// wrong reading at start must not become a velocity step). After [`Controller::new`] nothing
 /// allocates (`tests/no_alloc.rs`).
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Controller {
     config: ControllerConfig,
     data: ModelData,
     tasks: TaskSet,
+    /// The supervisor's `‖F_d‖` and `‖F_c‖` (whether or not the arrangement has these tasks).
+    proximity_signal: ProximityAvoidance,
+    contact_signal: ContactReaction,
+    /// Desired fused hand signal `f_c,d` of interactive-force-control paper eq. (9).
+    hand_force_reference: f64,
+    /// The commanded base motion, if any.
+    base_reference: Option<BaseReference>,
     solver: HierarchySolver,
     resolver: Resolver,
     supervisor: Supervisor,
@@ -80,6 +90,13 @@ impl Controller {
     /// Builds the controller at time `t0_s`: checks that frames, patches, task names and the
     /// posture fit the model, and allocates every buffer.
     pub fn new(config: ControllerConfig, t0_s: f64) -> Result<Self, SetupError> {
+        Self::with_tasks(config, t0_s, &[])
+    }
+
+    /// [`Controller::new`] with tasks of the caller's own beside [`crate::tasks::REGISTRY`]
+    /// (`crate::tasks::entry::<MyTask>()`), found by their names in the supervisor file like the
+    /// built-in ones (`docs/tasks.md`, "Adding a task").
+    pub fn with_tasks(config: ControllerConfig, t0_s: f64, extra: &[TaskEntry]) -> Result<Self, SetupError> {
         let model = &config.model;
         let nv = model.nv();
         let ee = model.frame_index(&config.setup.end_effector).ok_or_else(|| {
@@ -101,7 +118,17 @@ impl Controller {
             })?;
             locked[j] = true;
         }
-        let tasks = TaskSet::new(&config, ee)?;
+        let base_joints = model.planar_base();
+        let q_post = if config.setup.posture.is_empty() { vec![0.0; nv] } else { config.setup.posture.clone() };
+        let setup = TaskSetup {
+            model,
+            params: &config.tasks,
+            skin: &config.skin,
+            end_effector: ee,
+            base_joints,
+            posture: &q_post,
+        };
+        let tasks = TaskSet::new(&config, &setup, extra)?;
         let max_rows = tasks.levels.iter().map(|l| l.max_rows()).max().unwrap_or(0);
         let mut solver = HierarchySolver::new(nv, tasks.levels.len(), max_rows, config.setup.inverse)
             .map_err(|error| SetupError::Inverse { file: config.source.clone(), error })?;
@@ -144,6 +171,10 @@ impl Controller {
             started: false,
             output,
             tasks,
+            proximity_signal: ProximityAvoidance::new(nv, config.tasks.avoidance),
+            contact_signal: ContactReaction::new(nv, config.tasks.contact_reaction, &config.skin.force),
+            hand_force_reference: config.tasks.hand_force.force_signal_desired,
+            base_reference: None,
             supervisor,
             config,
         })
@@ -187,7 +218,7 @@ impl Controller {
         let layout = &self.config.layout;
         let hand_cells: usize =
             layout.patches().iter().zip(&self.hand_patches).filter(|(_, &h)| h).map(|(p, _)| p.cells.len()).sum();
-        self.tasks.set_hand_force_reference(signal.clamp(0.0, hand_cells as f64));
+        self.hand_force_reference = signal.clamp(0.0, hand_cells as f64);
         Ok(())
     }
 
@@ -197,21 +228,19 @@ impl Controller {
     /// `q_post`. Call it every cycle with the reference for that cycle's time. Refused: a
     /// non-finite value (`NonFinite`, index 0-2 position, 3-5 velocity), a model without base.
     pub fn set_base_reference(&mut self, reference: Option<BaseReference>) -> Result<(), Fault> {
-        let Some(joints) = self.resolver.base_joints() else {
-            return match reference {
-                Some(_) => Err(Fault::Stage("base reference (the model has no base joints)")),
-                None => Ok(()),
-            };
-        };
-        self.tasks.posture.set_base_reference(joints, reference).map_err(|e| match e {
-            crate::tasks::TaskError::NonFinite { index, .. } => Fault::NonFinite { input: "base reference", index },
-            _ => Fault::Stage("base reference"),
-        })
+        if reference.is_some() && self.resolver.base_joints().is_none() {
+            return Err(Fault::Stage("base reference (the model has no base joints)"));
+        }
+        if let Some(index) = reference.and_then(|r| r.non_finite()) {
+            return Err(Fault::NonFinite { input: "base reference", index });
+        }
+        self.base_reference = reference;
+        Ok(())
     }
 
     /// The commanded base motion in use ([`Controller::set_base_reference`]).
     pub fn base_reference(&self) -> Option<BaseReference> {
-        self.tasks.posture.base_reference()
+        self.base_reference
     }
 
     /// Requests a interactive-force-control paper phase (effective at the next update).
@@ -332,7 +361,7 @@ impl Controller {
         self.output.signals = signals;
         self.supervisor.update(input.t_s, &signals);
         if first || self.supervisor.last_transition().is_some() {
-            self.tasks.hold.capture(&self.data); // x_ef,init of interactive-force-control paper Table 1's contact phase
+            self.tasks.on_switch(&self.data); // x_ef,init of interactive-force-control paper Table 1's contact phase
         }
         let arrangement = self.supervisor.arrangement();
         let model = &self.config.model;
@@ -348,18 +377,24 @@ impl Controller {
         let (hand, guidance) = (&self.hand_patches, &self.guidance_patches);
         patch_poses_world(layout, |f| data.frame_pose(f), |j| hand[j] || guidance[j], &mut self.patch_poses);
 
-        let hand = self.hand_signals();
+        let mut hand = self.hand_signals();
+        hand.force_reference = self.hand_force_reference;
         self.output.hand_moment = data.frame_pose(self.ee).rotation.inverse_transform_vector(&hand.moment_world);
 
         // 3. tasks in priority order, posture, hierarchy
-        let cx = CycleContext {
+        let cx = Cycle {
             model,
             data,
-            config: &self.config,
+            layout,
+            skin: &self.config.skin,
             cells: &self.live,
+            wrenches: &self.wrenches,
+            body_patches: &self.body_patches,
             hand,
             goal: self.goal.as_ref(),
             sensing_range_m: arrangement.sensing_range_m,
+            scan: input.scan,
+            base_reference: self.resolver.base_joints().zip(self.base_reference),
         };
         let order = arrangement.task_order();
         let any_locked = self.locked.contains(&true);
@@ -369,16 +404,10 @@ impl Controller {
                 self.tasks.levels[i].lock_joints(&self.locked);
             }
         }
-        let has_posture = self
-            .tasks
-            .posture_torque(order, model, data, &self.config, &self.wrenches, &self.body_patches, input.scan)
-            .map_err(stage("posture torque"))?;
-        if has_posture && any_locked {
-            self.tasks.posture.lock_joints(&self.locked);
-        }
-        let posture = has_posture.then(|| self.tasks.posture.torque().as_slice());
-        let (kinds, levels) = (&self.tasks.kinds, &self.tasks.levels);
-        let active = order.iter().filter(|&&i| kinds[i].is_level()).map(|&i| &levels[i]);
+        let has_posture = self.tasks.posture_torque(order, &cx, &self.locked).map_err(stage("posture torque"))?;
+        let tasks = &self.tasks;
+        let posture = has_posture.then(|| tasks.posture().as_slice());
+        let active = order.iter().filter(|&&i| tasks.is_level(i)).map(|&i| &tasks.levels[i]);
         gravity(model, &mut self.data, &mut self.gravity).map_err(stage("gravity"))?;
         for (g, _) in self.gravity.iter_mut().zip(&self.locked).filter(|(_, &l)| l) {
             *g = 0.0; // a locked joint's virtual dynamics stay at rest (its τ* is 0)
@@ -425,9 +454,9 @@ impl Controller {
         let (model, data, config) = (&self.config.model, &self.data, &self.config);
         let (skin, layout) = (&config.skin, &config.layout);
         let nominal = config.supervisor.sensing_range.nominal_m;
-        let avoid = self.tasks.avoidance.summarize(layout, &self.live, nominal).map_err(stage("avoidance"))?;
+        let avoid = self.proximity_signal.summarize(layout, &self.live, nominal).map_err(stage("avoidance"))?;
         let contact =
-            self.tasks.contact.summarize(layout, &self.live, &skin.fusion).map_err(stage("contact reaction"))?;
+            self.contact_signal.summarize(layout, &self.live, &skin.fusion).map_err(stage("contact reaction"))?;
         let speed = point_velocity(model, data, self.ee, &nalgebra::Vector3::zeros())
             .map_err(stage("end-effector velocity"))?
             .norm();

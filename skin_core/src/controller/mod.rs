@@ -18,4 +18,3 @@ pub use cycle::Controller;
 pub use hand_force::HandForceMap;
 pub use io::{ControllerInput, ControllerOutput, Fault};
 pub use setup::{ControllerConfig, ControllerSetup, HierarchyDynamics, SetupError};
-pub use task_set::TaskKind;

@@ -188,12 +188,13 @@ fn derived_setup_errors_name_the_file_and_key() {
 }
 
 #[test]
-fn task_names_map_to_kinds() {
-    for (name, kind) in TaskKind::ALL {
-        assert_eq!(TaskKind::from_name(name), Some(kind));
+fn every_registered_task_is_found_by_its_own_name() {
+    for entry in crate::tasks::REGISTRY.iter() {
+        assert_eq!(crate::tasks::lookup(entry.name).map(|e| e.name), Some(entry.name), "names are unique");
     }
-    assert_eq!(TaskKind::from_name("levitate"), None);
-    assert!(!TaskKind::Posture.is_level() && TaskKind::Goal.is_level());
+    assert!(crate::tasks::lookup("levitate").is_none());
+    let role = |name| crate::tasks::lookup(name).unwrap().role;
+    assert!(!role("posture").is_level() && !role("compliance").is_level() && role("goal").is_level());
 }
 
 #[test]

@@ -166,6 +166,10 @@ pub(crate) struct Frame {
     pub(crate) collisions: Vec<Collision>,
 }
 
+/// Names of the holonomic base's joints in a model: world-frame x, y (prismatic) and yaw.
+/// A model has all three (a mobile robot) or none (a fixed arm).
+pub const BASE_JOINTS: [&str; 3] = ["base_x_joint", "base_y_joint", "base_yaw_joint"];
+
 /// Immutable robot model built from a URDF. Joint order ("model order") is depth-first from the
 /// root link, children in document order; it is the order of every q, q̇, τ vector.
 ///
@@ -260,6 +264,13 @@ impl RobotModel {
     /// Generalized coordinate of a joint name (None for unknown names and followed mimic joints).
     pub fn joint_index(&self, name: &str) -> Option<usize> {
         self.joint_names.iter().position(|n| n == name)
+    }
+
+    /// Generalized coordinates of the holonomic base's x, y, yaw joints ([`BASE_JOINTS`]), if the
+    /// robot has all three.
+    pub fn planar_base(&self) -> Option<[usize; 3]> {
+        let [x, y, yaw] = BASE_JOINTS.map(|n| self.joint_index(n));
+        Some([x?, y?, yaw?])
     }
 
     /// Limits of the generalized coordinates in model order.

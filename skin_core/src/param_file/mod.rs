@@ -8,6 +8,7 @@ use std::path::Path;
 use serde::de::DeserializeOwned;
 use thiserror::Error;
 
+pub mod declare;
 pub mod yaml;
 
 use yaml::YamlError;
@@ -21,7 +22,7 @@ pub struct InvalidParam {
     /// The offending value.
     pub value: f64,
     /// Why it is invalid.
-    pub reason: &'static str,
+    pub reason: std::borrow::Cow<'static, str>,
 }
 
 impl InvalidParam {
@@ -30,7 +31,7 @@ impl InvalidParam {
         if value.is_finite() && value > 0.0 {
             Ok(())
         } else {
-            Err(InvalidParam { key: format!("{prefix}{name}"), value, reason: "must be finite and > 0" })
+            Err(InvalidParam { key: format!("{prefix}{name}"), value, reason: "must be finite and > 0".into() })
         }
     }
 
@@ -46,7 +47,7 @@ impl InvalidParam {
         if value.is_finite() && (lo..=hi).contains(&value) {
             Ok(())
         } else {
-            Err(InvalidParam { key: format!("{prefix}{name}"), value, reason })
+            Err(InvalidParam { key: format!("{prefix}{name}"), value, reason: reason.into() })
         }
     }
 }

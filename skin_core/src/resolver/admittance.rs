@@ -4,11 +4,7 @@
 use super::error::ResolverError;
 use super::limits::{clamp_norm, finite_or_max, position_limit, rate_limit, scale_chains};
 use super::params::ResolverParams;
-use crate::model::RobotModel;
-
-/// Names of the holonomic base's joints in the model: world-frame x, y (prismatic) and yaw.
-/// A model has all three (a mobile robot) or none (a fixed arm).
-pub const BASE_JOINTS: [&str; 3] = ["base_x_joint", "base_y_joint", "base_yaw_joint"];
+use crate::model::{RobotModel, BASE_JOINTS};
 
 /// A late cycle integrates over at most this many nominal periods (no large velocity step).
 const MAX_DT_PERIODS: f64 = 2.0;
@@ -95,16 +91,12 @@ impl Resolver {
     /// Builds the resolver for `model`: base joints by name ([`BASE_JOINTS`]), every other moving
     /// joint is an arm joint; velocity and position limits come from the URDF.
     pub fn new(model: &RobotModel, params: ResolverParams) -> Result<Self, ResolverError> {
-        let found: Vec<Option<usize>> = BASE_JOINTS.iter().map(|n| model.joint_index(n)).collect();
-        let base = match found.as_slice() {
-            [Some(x), Some(y), Some(yaw)] => Some([*x, *y, *yaw]),
-            [None, None, None] => None,
-            _ => {
-                return Err(ResolverError::Model(format!(
-                    "a mobile base needs all of {BASE_JOINTS:?}, the model has only some of them"
-                )))
-            }
-        };
+        let base = model.planar_base();
+        if base.is_none() && BASE_JOINTS.iter().any(|n| model.joint_index(n).is_some()) {
+            return Err(ResolverError::Model(format!(
+                "a mobile base needs all of {BASE_JOINTS:?}, the model has only some of them"
+            )));
+        }
         let is_base = |j: usize| base.is_some_and(|b| b.contains(&j));
         let arm_indices: Vec<usize> = (0..model.nv()).filter(|&j| !is_base(j)).collect();
         // A chain (one arm) = the arm joints below one root arm joint (attached to the world or

@@ -19,6 +19,8 @@ mod params;
 #[cfg(test)]
 mod tests;
 
-pub use admittance::{Commands, Resolver, BASE_JOINTS};
+/// The base joint names live with the model; re-exported where the resolver splits arm and base.
+pub use crate::model::BASE_JOINTS;
+pub use admittance::{Commands, Resolver};
 pub use error::ResolverError;
 pub use params::{ArmParams, BaseParams, JointOverride, ResolverParams};

@@ -4,6 +4,8 @@
 //! frame, i.e. along the OUTWARD normal. The physical force that a touch exerts on the robot
 //! points inward; controllers react with `-K F` (interactive-force-control paper eq. (12)) to yield to it.
 
+use crate::declare_params;
+use crate::param_file::declare::{Declared, Range};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
@@ -41,31 +43,26 @@ impl LengthMismatch {
     }
 }
 
-/// Parameters of the force/proximity fusion (interactive-force-control paper eq. (6)) and of cell activity.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FusionParams {
-    /// `w` of interactive-force-control paper eq. (6) in [0, 1]: 0 = proximity only, 1 = force only.
-    pub weight_force: f64,
-    /// A cell is active when its fused signal `sF` exceeds this value, in [0, 1).
-    pub activity_threshold: f64,
-    /// Reduction of the cell's three force sensors to one signal.
-    #[serde(default)]
-    pub force_reduction: ForceReduction,
+declare_params! {
+    /// Parameters of the force/proximity fusion (interactive-force-control paper eq. (6)) and of cell activity.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct FusionParams {
+        /// `w` of interactive-force-control paper eq. (6): the cell's virtual force
+        /// `sF = w f + (1 - w) p` (0: proximity only, 1: force only).
+        pub weight_force: f64 => { unit: "", range: Range::closed(0.0, 1.0), live: true },
+        /// A cell is active (enters the patch wrench, eq. 7-8) when its fused signal `sF` exceeds this.
+        pub activity_threshold: f64 => { unit: "", range: Range::below(0.0, 1.0), live: true },
+        /// How a cell's three force sensors make one signal.
+        #[serde(default)]
+        pub force_reduction: ForceReduction => { choices: "mean | max", live: true },
+    }
 }
 
 impl FusionParams {
-    /// Checks `weight_force` in [0, 1] and `activity_threshold` in [0, 1).
+    /// Checks the declared ranges.
     pub fn validate(&self, prefix: &str) -> Result<(), InvalidParam> {
-        InvalidParam::in_range(prefix, "weight_force", self.weight_force, 0.0, 1.0, "must be in [0, 1]")?;
-        InvalidParam::in_range(
-            prefix,
-            "activity_threshold",
-            self.activity_threshold,
-            0.0,
-            1.0 - f64::EPSILON,
-            "must be in [0, 1)",
-        )
+        self.check(prefix)
     }
 }
 

@@ -15,6 +15,8 @@
 //! saturated ends the inverses return the end of the domain (`range_m` for `p = 0`, `max_n` for
 //! `f = 1`), never Inf or NaN.
 
+use crate::declare_params;
+use crate::param_file::declare::{Declared, Range};
 use serde::{Deserialize, Serialize};
 
 use crate::param_file::InvalidParam;
@@ -33,22 +35,24 @@ pub fn sanitize_signal(signal: f64) -> f64 {
     signal.max(0.0).min(1.0)
 }
 
-/// Proximity characteristic: distance \[m\] to the normalized proximity signal [0, 1].
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ProximityCharacteristic {
-    /// Sensing range \[m\]: at and beyond this distance the signal is 0.
-    pub range_m: f64,
-    /// Decay length \[m\] of the exponential: smaller means more sensitive close to the surface.
-    pub decay_m: f64,
+declare_params! {
+    /// Proximity characteristic: distance \[m\] to the normalized proximity signal [0, 1].
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct ProximityCharacteristic {
+        /// Sensing range: at and beyond this distance the signal is 0 (intentional-contact paper
+        /// eq. 3 `d_range`).
+        pub range_m: f64 => { unit: "m", range: Range::positive(1.0), live: true },
+        /// Decay length of the exponential: smaller means more sensitive close to the surface.
+        pub decay_m: f64 => { unit: "m", range: Range::positive(1.0), live: true },
+    }
 }
 
 impl ProximityCharacteristic {
     /// Checks that both parameters are finite and positive and `range_m / decay_m <=`
     /// [`MAX_SPAN_RATIO`]. `prefix` is prepended to the key names in the error (e.g. `"proximity."`).
     pub fn validate(&self, prefix: &str) -> Result<(), InvalidParam> {
-        InvalidParam::positive_finite(prefix, "range_m", self.range_m)?;
-        InvalidParam::positive_finite(prefix, "decay_m", self.decay_m)?;
+        self.check(prefix)?;
         InvalidParam::in_range(
             prefix,
             "decay_m",
@@ -122,22 +126,23 @@ impl PreparedProximity {
     }
 }
 
-/// Force characteristic: normal force \[N\] on a cell to the normalized force signal [0, 1].
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ForceCharacteristic {
-    /// Force scale \[N\] of the exponential: smaller means more sensitive at low forces.
-    pub scale_n: f64,
-    /// Saturation force \[N\]: at and beyond it the signal is 1.
-    pub max_n: f64,
+declare_params! {
+    /// Force characteristic: normal force \[N\] on a cell to the normalized force signal [0, 1].
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct ForceCharacteristic {
+        /// Force scale of the exponential: smaller means more sensitive at low forces.
+        pub scale_n: f64 => { unit: "N", range: Range::positive(1e3), live: true },
+        /// Saturation force: at and beyond it the signal is 1.
+        pub max_n: f64 => { unit: "N", range: Range::positive(1e3), live: true },
+    }
 }
 
 impl ForceCharacteristic {
     /// Checks that both parameters are finite and positive and `max_n / scale_n <=`
     /// [`MAX_SPAN_RATIO`]. `prefix` is prepended to the key names in the error (e.g. `"force."`).
     pub fn validate(&self, prefix: &str) -> Result<(), InvalidParam> {
-        InvalidParam::positive_finite(prefix, "scale_n", self.scale_n)?;
-        InvalidParam::positive_finite(prefix, "max_n", self.max_n)?;
+        self.check(prefix)?;
         InvalidParam::in_range(
             prefix,
             "scale_n",

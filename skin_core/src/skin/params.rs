@@ -8,20 +8,23 @@ use serde::{Deserialize, Serialize};
 use super::aggregate::FusionParams;
 use super::characteristic::{ForceCharacteristic, ProximityCharacteristic};
 use super::repulsion::RepulsionParams;
+use crate::declare_params;
 use crate::param_file::{load_validated, parse_validated, InvalidParam, ParamsError};
 
-/// All skin model parameters (one YAML file, sections as the fields).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SkinParams {
-    /// Proximity characteristic (distance <-> signal).
-    pub proximity: ProximityCharacteristic,
-    /// Force characteristic (force <-> signal).
-    pub force: ForceCharacteristic,
-    /// Fusion of force and proximity into the cells' virtual force (interactive-force-control paper eq. (6)).
-    pub fusion: FusionParams,
-    /// Repulsion from proximity (intentional-contact paper eq. (3), interactive-force-control paper eq. (16)).
-    pub repulsion: RepulsionParams,
+declare_params! {
+    /// All skin model parameters (one YAML file, sections as the fields).
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct SkinParams {
+        /// Proximity characteristic (distance <-> signal).
+        pub proximity: ProximityCharacteristic => nested,
+        /// Force characteristic (force <-> signal).
+        pub force: ForceCharacteristic => nested,
+        /// Fusion of force and proximity into the cells' virtual force (interactive-force-control paper eq. (6)).
+        pub fusion: FusionParams => nested,
+        /// Repulsion from proximity (intentional-contact paper eq. (3), interactive-force-control paper eq. (16)).
+        pub repulsion: RepulsionParams => nested,
+    }
 }
 
 impl SkinParams {
@@ -35,7 +38,7 @@ impl SkinParams {
             return Err(InvalidParam {
                 key: "repulsion.range_m".into(),
                 value: self.repulsion.range_m,
-                reason: "must not exceed proximity.range_m (the cells measure no farther)",
+                reason: "must not exceed proximity.range_m (the cells measure no farther)".into(),
             });
         }
         Ok(())

@@ -1,31 +1,33 @@
 //! Repulsive force laws: intentional-contact paper eq. (3) (linear, per skin cell) and interactive-force-control paper eq. (16)
 //! (exponential).
 
+use crate::declare_params;
+use crate::param_file::declare::{Declared, Range};
 use serde::{Deserialize, Serialize};
 
 use crate::param_file::InvalidParam;
 
-/// Parameters of the repulsive force laws.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RepulsionParams {
-    /// `K` of intentional-contact paper eq. (3) \[N/m\].
-    pub gain_n_per_m: f64,
-    /// `d_range` of intentional-contact paper eq. (3) \[m\]: no repulsion at or beyond it.
-    pub range_m: f64,
-    /// `f_max` of interactive-force-control paper eq. (16) \[N\]: the force at distance 0.
-    pub max_force_n: f64,
-    /// `alpha` of interactive-force-control paper eq. (16) \[m\]: decay length.
-    pub decay_m: f64,
+declare_params! {
+    /// Parameters of the repulsive force laws.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct RepulsionParams {
+        /// `K` of intentional-contact paper eq. (3).
+        pub gain_n_per_m: f64 => { unit: "N/m", range: Range::positive(1e5), live: true },
+        /// `d_range` of intentional-contact paper eq. (3): no repulsion at or beyond it
+        /// (at most `proximity.range_m`).
+        pub range_m: f64 => { unit: "m", range: Range::positive(1.0), live: true },
+        /// `f_max` of interactive-force-control paper eq. (16): the force at distance 0.
+        pub max_force_n: f64 => { unit: "N", range: Range::positive(1e3), live: true },
+        /// `alpha` of interactive-force-control paper eq. (16): decay length.
+        pub decay_m: f64 => { unit: "m", range: Range::positive(10.0), live: true },
+    }
 }
 
 impl RepulsionParams {
-    /// Checks that every parameter is finite and positive.
+    /// Checks the declared ranges.
     pub fn validate(&self, prefix: &str) -> Result<(), InvalidParam> {
-        InvalidParam::positive_finite(prefix, "gain_n_per_m", self.gain_n_per_m)?;
-        InvalidParam::positive_finite(prefix, "range_m", self.range_m)?;
-        InvalidParam::positive_finite(prefix, "max_force_n", self.max_force_n)?;
-        InvalidParam::positive_finite(prefix, "decay_m", self.decay_m)
+        self.check(prefix)
     }
 
     /// Intentional-contact paper eq. (3) with these parameters, see [`linear_repulsion`].

@@ -225,7 +225,7 @@ impl SupervisorParams {
             return Err(InvalidParam {
                 key: "thresholds.contact_band_n".into(),
                 value: t.contact_band_n,
-                reason: "must be >= 0 and < contact_force_n (else hard contact is never left)",
+                reason: "must be >= 0 and < contact_force_n (else hard contact is never left)".into(),
             }
             .into());
         }
@@ -271,7 +271,7 @@ impl SupervisorParams {
             return Err(InvalidParam {
                 key: "log_capacity".into(),
                 value: self.log_capacity as f64,
-                reason: "must be in [1, 100000]",
+                reason: "must be in [1, 100000]".into(),
             }
             .into());
         }

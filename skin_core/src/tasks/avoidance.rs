@@ -12,6 +12,7 @@
 
 use super::params::AvoidanceParams;
 use super::point_rows::{push_inward_cell_row, row_activation};
+use super::task::{Cycle, Role, Rows, Task, TaskSetup};
 use super::TaskError;
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
@@ -112,5 +113,23 @@ impl AvoidanceParams {
         }
         s.force_norm_n = sum_sq.sqrt();
         Ok(s)
+    }
+}
+
+impl Task for ProximityAvoidance {
+    fn name() -> &'static str {
+        "avoidance"
+    }
+
+    fn role() -> Role {
+        Role::Level(Rows::PerCell)
+    }
+
+    fn build(s: &TaskSetup) -> Result<Self, TaskError> {
+        Ok(Self::new(s.model.nv(), s.params.avoidance))
+    }
+
+    fn fill(&mut self, cx: &Cycle, level: &mut TaskLevel) -> Result<(), TaskError> {
+        self.update(cx.model, cx.data, cx.layout, cx.cells, cx.sensing_range_m, level).map(drop)
     }
 }

@@ -14,6 +14,7 @@
 use nalgebra::{DVector, Vector2, Vector3};
 
 use super::params::BaseAvoidanceParams;
+use super::task::{Cycle, Role, Task, TaskSetup};
 use super::TaskError;
 
 /// A pseudo-angle of the direction `(x, y)` in `[0, 4)`: 0 along +x, 1 along +y, 2 along −x, 3
@@ -174,6 +175,34 @@ impl BaseAvoidance {
     /// `τ_oca` of the last update (toward the obstacles; eq. 18 subtracts it).
     pub fn torque(&self) -> &DVector<f64> {
         &self.tau
+    }
+}
+
+/// `base_avoidance` in an arrangement: eq. (15)-(17) on the robot's mobile base from this cycle's
+/// LIDAR points, a term of `τ_s`; nothing on a robot without a mobile base.
+#[derive(Debug, Clone)]
+pub struct MobileBaseAvoidance(pub Option<BaseAvoidance>);
+
+impl Task for MobileBaseAvoidance {
+    fn name() -> &'static str {
+        "base_avoidance"
+    }
+
+    fn role() -> Role {
+        Role::PostureTerm
+    }
+
+    fn build(s: &TaskSetup) -> Result<Self, TaskError> {
+        let base = s.base_joints.map(|joints| BaseAvoidance::new(s.model.nv(), joints, s.params.base_avoidance));
+        Ok(MobileBaseAvoidance(base.transpose()?))
+    }
+
+    fn torque(&mut self, cx: &Cycle, tau_s: &mut DVector<f64>) -> Result<(), TaskError> {
+        if let Some(base) = &mut self.0 {
+            base.update(cx.data.q(), cx.scan)?;
+            *tau_s += base.torque();
+        }
+        Ok(())
     }
 }
 

@@ -12,6 +12,7 @@
 
 use super::params::ContactReactionParams;
 use super::point_rows::{push_inward_cell_row, row_activation};
+use super::task::{Cycle, Role, Rows, Task, TaskSetup};
 use super::TaskError;
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
@@ -105,5 +106,23 @@ impl ContactReactionParams {
             s.max_measured_n = s.max_measured_n.max(measured);
         }
         Ok(s)
+    }
+}
+
+impl Task for ContactReaction {
+    fn name() -> &'static str {
+        "contact_reaction"
+    }
+
+    fn role() -> Role {
+        Role::Level(Rows::PerCell)
+    }
+
+    fn build(s: &TaskSetup) -> Result<Self, TaskError> {
+        Ok(Self::new(s.model.nv(), s.params.contact_reaction, &s.skin.force))
+    }
+
+    fn fill(&mut self, cx: &Cycle, level: &mut TaskLevel) -> Result<(), TaskError> {
+        self.update(cx.model, cx.data, cx.layout, cx.cells, &cx.skin.fusion, level).map(drop)
     }
 }

@@ -9,6 +9,7 @@
 use nalgebra::{Matrix6xX, UnitQuaternion, Vector3};
 
 use super::params::GoalParams;
+use super::task::{Cycle, Role, Rows, Task, TaskSetup};
 use super::{rows_times_qd, TaskError};
 use crate::hierarchy::{Reference, TaskLevel};
 use crate::model::{point_jacobian, ModelData, RobotModel};
@@ -92,5 +93,49 @@ impl GoalOrientation {
         self.moment = saturated_goal_force(&self.params, &error, &w);
         level.set(&self.jac.fixed_rows::<3>(3), Reference::Force { f: self.moment.as_slice() })?;
         Ok(self.moment)
+    }
+}
+
+impl Task for GoalPosition {
+    fn name() -> &'static str {
+        "goal"
+    }
+
+    fn role() -> Role {
+        Role::Level(Rows::Fixed(3))
+    }
+
+    fn build(s: &TaskSetup) -> Result<Self, TaskError> {
+        Ok(Self::new(s.model.nv(), s.end_effector, Vector3::zeros(), s.params.goal))
+    }
+
+    /// Empty without a goal.
+    fn fill(&mut self, cx: &Cycle, level: &mut TaskLevel) -> Result<(), TaskError> {
+        match cx.goal {
+            Some(goal) => self.update(cx.model, cx.data, &goal.translation.vector, level).map(drop),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Task for GoalOrientation {
+    fn name() -> &'static str {
+        "goal_orientation"
+    }
+
+    fn role() -> Role {
+        Role::Level(Rows::Fixed(3))
+    }
+
+    fn build(s: &TaskSetup) -> Result<Self, TaskError> {
+        Ok(Self::new(s.model.nv(), s.end_effector, s.params.goal_orientation))
+    }
+
+    /// Empty without a goal.
+    fn fill(&mut self, cx: &Cycle, level: &mut TaskLevel) -> Result<(), TaskError> {
+        match cx.goal {
+            Some(goal) => self.update(cx.model, cx.data, &goal.rotation, level).map(drop),
+            None => Ok(()),
+        }
     }
 }

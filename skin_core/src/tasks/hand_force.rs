@@ -23,6 +23,7 @@ use nalgebra::Vector3;
 
 use super::params::HandForceParams;
 use super::point_rows::{PointRows, ANGULAR, LINEAR};
+use super::task::{Cycle, Role, Rows, Task, TaskSetup};
 use super::TaskError;
 use crate::hierarchy::{Reference, TaskLevel};
 use crate::model::{ModelData, RobotModel};
@@ -110,5 +111,49 @@ impl HandForce {
             Reference::Acceleration { xdd_star: &[xdd], jdot_qdot: &[jdot_qdot] },
         )?;
         Ok(xdd)
+    }
+}
+
+impl Task for HandForce {
+    fn name() -> &'static str {
+        "hand_force"
+    }
+
+    fn role() -> Role {
+        Role::Level(Rows::Fixed(1))
+    }
+
+    fn build(s: &TaskSetup) -> Result<Self, TaskError> {
+        Ok(Self::new(s.model.nv(), s.end_effector, s.params.hand_force))
+    }
+
+    /// Eq. (9) on the fused hand signal toward the reference of this cycle.
+    fn fill(&mut self, cx: &Cycle, level: &mut TaskLevel) -> Result<(), TaskError> {
+        self.params.force_signal_desired = cx.hand.force_reference;
+        let m = HandMeasurement::Force { fused_signal: cx.hand.fused_force };
+        self.update(cx.model, cx.data, m, cx.hand.proximity, &cx.skin.proximity, level).map(drop)
+    }
+}
+
+/// `hand_distance`: the hand task of eq. (9) on the hand's proximity (the approach).
+#[derive(Debug, Clone)]
+pub struct HandDistance(pub HandForce);
+
+impl Task for HandDistance {
+    fn name() -> &'static str {
+        "hand_distance"
+    }
+
+    fn role() -> Role {
+        Role::Level(Rows::Fixed(1))
+    }
+
+    fn build(s: &TaskSetup) -> Result<Self, TaskError> {
+        HandForce::build(s).map(HandDistance)
+    }
+
+    fn fill(&mut self, cx: &Cycle, level: &mut TaskLevel) -> Result<(), TaskError> {
+        let m = HandMeasurement::Distance { proximity_signal: cx.hand.proximity };
+        self.0.update(cx.model, cx.data, m, cx.hand.proximity, &cx.skin.proximity, level).map(drop)
     }
 }

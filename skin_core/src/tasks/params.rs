@@ -5,221 +5,187 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use crate::declare_params;
+use crate::param_file::declare::{Declared, Range};
 use crate::param_file::{load_validated, parse_validated, InvalidParam, ParamsError};
 
-/// Intentional-contact paper eq. (7)-(9): goal task gains and speed limit (used for position and orientation).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GoalParams {
-    /// Position gain `k_p` \[N/m\] (or N m/rad for orientation).
-    pub kp_n_per_m: f64,
-    /// Velocity gain `k_v` \[N s/m\] (or N m s/rad).
-    pub kv_n_s_per_m: f64,
-    /// Speed limit `V_max` \[m/s\] (or rad/s) of eq. (9).
-    pub v_max_m_per_s: f64,
-}
-
-/// Intentional-contact paper eq. (3): proximity avoidance `F_di = K (d_range - d_i)`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct AvoidanceParams {
-    /// `K` \[N/m\].
-    pub gain_n_per_m: f64,
-    /// Nominal `d_range` \[m\]; the supervisor may pass a smaller one per cycle.
-    pub range_m: f64,
-    /// Width of the outer band of the range over which a cell's row fades into the null-space
-    /// projector \[m\] (activation 0 at `d_range`, 1 from `d_range − band` inward; capped by the
-    /// current range). 0: rows switch on at once (the projector then jumps at the boundary).
-    pub activation_band_m: f64,
-}
-
-/// Intentional-contact paper eq. (6): contact reaction `F_ci = gain F_i` along the inward normal.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ContactReactionParams {
-    /// Dimensionless gain on the measured cell force of eq. (6).
-    pub gain: f64,
-    /// Measured cell force at which a contact row is fully active in the null-space projector
-    /// \[N\] (activation rises smoothly from 0 at no force). 0: rows switch on at once.
-    pub activation_force_n: f64,
-}
-
-/// Interactive-force-control paper eq. (9): hand force / distance control on one row.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct HandForceParams {
-    /// Desired inertia `Λ_1` \[kg\].
-    pub lambda_kg: f64,
-    /// `K_1` in force mode \[1/signal · N\] (signal error to task force).
-    pub k_force_n_per_signal: f64,
-    /// `K_1` in distance mode \[N/m\].
-    pub k_distance_n_per_m: f64,
-    /// `D_1` \[N s/m\].
-    pub d_n_s_per_m: f64,
-    /// Desired fused contact signal `f_c,d` (contact phase, Table 1), ≥ 0: the hand patch's
-    /// summed virtual force (eq. 7 sums the active cells' signals, so it can exceed 1).
-    pub force_signal_desired: f64,
-    /// Desired distance `d_p,d` \[m\] (approach phase, Table 1).
-    pub distance_desired_m: f64,
-    /// Approach speed bound: the hand may close on a sensed surface at most at
-    /// `approach_speed_min_mps + d / approach_time_s`, `d` the distance its proximity reads
-    /// (see [`super::hand_force::approach_speed_limit`]) \[s\].
-    pub approach_time_s: f64,
-    /// Closing speed still allowed at `d = 0` (touching) \[m/s\].
-    pub approach_speed_min_mps: f64,
-}
-
-/// Impedance of a 3-row acceleration task, interactive-force-control paper eq. (4)/(5): diagonals of `Λ`, `K`, `D`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Impedance3 {
-    /// Diagonal of `Λ` \[kg or kg m²\].
-    pub lambda: [f64; 3],
-    /// Diagonal of `K` \[N/m, N m/rad, or N per signal unit\].
-    pub k: [f64; 3],
-    /// Diagonal of `D` \[N s/m or N m s/rad\].
-    pub d: [f64; 3],
-}
-
-/// Interactive-force-control paper eq. (15)-(17): mobile-base collision avoidance from laser points.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BaseAvoidanceParams {
-    /// `f_max` of eq. (16) \[N\].
-    pub f_max_n: f64,
-    /// `α` of eq. (16) \[m\].
-    pub alpha_m: f64,
-    /// Points farther than this from the footprint are ignored \[m\].
-    pub range_m: f64,
-    /// Footprint rectangle in the base frame: `[x_min, x_max]` \[m\].
-    pub footprint_x_m: [f64; 2],
-    /// Footprint rectangle in the base frame: `[y_min, y_max]` \[m\].
-    pub footprint_y_m: [f64; 2],
-    /// Angular sectors (about the base origin); the closest point of each sector is one `o_i`.
-    pub sectors: usize,
-}
-
-/// Interactive-force-control paper eq. (18): joint compliance / posture.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PostureParams {
-    /// `K_c` diagonal (one per joint, or one value for all) \[N m/rad or N/m\].
-    pub k_c: Vec<f64>,
-    /// `D_c` diagonal (one per joint, or one value for all) \[N m s/rad or N s/m\].
-    pub d_c: Vec<f64>,
-    /// Gain on the body skin torque `τ_skin` (eq. 14) inside `τ_s` \[N per signal unit\].
-    pub skin_gain: f64,
-    /// `K_c`, `D_c` of the base joints (x, y, yaw) at rest, replacing `k_c`, `d_c` there (none:
-    /// `k_c`, `d_c`): the base's virtual mass is far larger than an arm joint's inertia, so the
-    /// arm's damping leaves it ringing after a touch.
-    #[serde(default)]
-    pub base: Option<BaseGains>,
-    /// `K_c`, `D_c` of the base joints while they track a commanded base motion
-    /// ([`super::posture::BaseReference`]); none: the base joints' gains at rest.
-    #[serde(default)]
-    pub base_tracking: Option<BaseGains>,
-}
-
-/// Gains of the base joints (world x, y, yaw) in the posture torque of eq. (18): at rest, or
-/// toward a commanded base motion (stiffer than the posture's, so that the lowest level follows
-/// the motion against the arm's own posture pull).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BaseGains {
-    /// Stiffness along x, y \[N/m\] and about yaw \[N m/rad\].
-    pub k_c: [f64; 3],
-    /// Damping along x, y \[N s/m\] and about yaw \[N m s/rad\].
-    pub d_c: [f64; 3],
-}
-
-/// Every task's parameters (`config/tasks.yaml`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TaskParams {
-    /// End-effector position goal (intentional-contact paper eq. 7-9).
-    pub goal: GoalParams,
-    /// End-effector orientation goal (same law, angular rows).
-    pub goal_orientation: GoalParams,
-    /// Proximity avoidance (intentional-contact paper eq. 3).
-    pub avoidance: AvoidanceParams,
-    /// Contact reaction (intentional-contact paper eq. 6).
-    pub contact_reaction: ContactReactionParams,
-    /// Hand force/distance (interactive-force-control paper eq. 9).
-    pub hand_force: HandForceParams,
-    /// Compliant wrist (interactive-force-control paper eq. 10).
-    pub wrist: Impedance3,
-    /// Tactile guidance (interactive-force-control paper eq. 11-12).
-    pub tactile_guidance: Impedance3,
-    /// Cartesian position hold (interactive-force-control paper eq. 4, Table 1).
-    pub position_hold: Impedance3,
-    /// Base collision avoidance (interactive-force-control paper eq. 15-17).
-    pub base_avoidance: BaseAvoidanceParams,
-    /// Joint compliance / posture (interactive-force-control paper eq. 18).
-    pub posture: PostureParams,
-}
-
-fn pos(prefix: &str, name: &str, v: f64) -> Result<(), InvalidParam> {
-    InvalidParam::positive_finite(prefix, name, v)
-}
-
-fn nonneg(prefix: &str, name: &str, v: f64) -> Result<(), InvalidParam> {
-    InvalidParam::in_range(prefix, name, v, 0.0, f64::INFINITY, "must be finite and >= 0")
-}
-
-impl GoalParams {
-    /// Checks gains and speed limit (all > 0).
-    pub fn validate(&self, prefix: &str) -> Result<(), InvalidParam> {
-        pos(prefix, "kp_n_per_m", self.kp_n_per_m)?;
-        pos(prefix, "kv_n_s_per_m", self.kv_n_s_per_m)?;
-        pos(prefix, "v_max_m_per_s", self.v_max_m_per_s)
+declare_params! {
+    /// Intentional-contact paper eq. (7)-(9): goal task gains and speed limit (used for position and
+    /// orientation; the orientation's units are per radian).
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct GoalParams {
+        /// Position gain `k_p` (N m/rad for the orientation).
+        pub kp_n_per_m: f64 => { unit: "N/m", range: Range::positive(1e5), live: false },
+        /// Velocity gain `k_v` (N m s/rad for the orientation).
+        pub kv_n_s_per_m: f64 => { unit: "N s/m", range: Range::positive(1e4), live: false },
+        /// Speed limit `V_max` of eq. (9) (rad/s for the orientation).
+        pub v_max_m_per_s: f64 => { unit: "m/s", range: Range::positive(2.0), live: false },
     }
 }
 
-impl Impedance3 {
-    /// Checks `Λ > 0`, `K >= 0`, `D >= 0`.
-    pub fn validate(&self, prefix: &str) -> Result<(), InvalidParam> {
-        for i in 0..3 {
-            pos(prefix, &format!("lambda[{i}]"), self.lambda[i])?;
-            nonneg(prefix, &format!("k[{i}]"), self.k[i])?;
-            nonneg(prefix, &format!("d[{i}]"), self.d[i])?;
-        }
-        Ok(())
+declare_params! {
+    /// Intentional-contact paper eq. (3): proximity avoidance `F_di = K (d_range - d_i)`.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct AvoidanceParams {
+        /// `K`.
+        pub gain_n_per_m: f64 => { unit: "N/m", range: Range::positive(1e5), live: false },
+        /// Nominal `d_range`; the supervisor may pass a smaller one per cycle.
+        pub range_m: f64 => { unit: "m", range: Range::closed(0.0, 1.0), live: false },
+        /// Width of the outer band of the range over which a cell's row fades into the null-space
+        /// projector (activation 0 at `d_range`, 1 from `d_range − band` inward; capped by the
+        /// current range). 0: rows switch on at once (the projector then jumps at the boundary).
+        pub activation_band_m: f64 => { unit: "m", range: Range::closed(0.0, 1.0), live: false },
+    }
+}
+
+declare_params! {
+    /// Intentional-contact paper eq. (6): contact reaction `F_ci = gain F_i` along the inward normal.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct ContactReactionParams {
+        /// Gain on the measured cell force of eq. (6).
+        pub gain: f64 => { unit: "", range: Range::closed(0.0, 100.0), live: false },
+        /// Measured cell force at which a contact row is fully active in the null-space projector
+        /// (activation rises smoothly from 0 at no force). 0: rows switch on at once.
+        pub activation_force_n: f64 => { unit: "N", range: Range::closed(0.0, 100.0), live: false },
+    }
+}
+
+declare_params! {
+    /// Interactive-force-control paper eq. (9): hand force / distance control on one row.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct HandForceParams {
+        /// Desired inertia `Λ_1`.
+        pub lambda_kg: f64 => { unit: "kg", range: Range::positive(1e3), live: false },
+        /// `K_1` in force mode (signal error to task force).
+        pub k_force_n_per_signal: f64 => { unit: "N per signal unit", range: Range::closed(0.0, 1e3), live: false },
+        /// `K_1` in distance mode.
+        pub k_distance_n_per_m: f64 => { unit: "N/m", range: Range::closed(0.0, 1e4), live: false },
+        /// `D_1`.
+        pub d_n_s_per_m: f64 => { unit: "N s/m", range: Range::closed(0.0, 1e4), live: false },
+        /// Desired fused contact signal `f_c,d` (contact phase, Table 1): the hand patch's summed
+        /// virtual force (eq. 7 sums the active cells' signals, so it can exceed 1).
+        pub force_signal_desired: f64 => { unit: "signal", range: Range::closed(0.0, 1e4), live: false },
+        /// Desired distance `d_p,d` (approach phase, Table 1).
+        pub distance_desired_m: f64 => { unit: "m", range: Range::closed(0.0, 1.0), live: false },
+        /// Approach speed bound: the hand may close on a sensed surface at most at
+        /// `approach_speed_min_mps + d / approach_time_s`, `d` the distance its proximity reads
+        /// (`tasks::hand_force::approach_speed_limit`).
+        pub approach_time_s: f64 => { unit: "s", range: Range::positive(100.0), live: false },
+        /// Closing speed still allowed at `d = 0` (touching).
+        pub approach_speed_min_mps: f64 => { unit: "m/s", range: Range::positive(1.0), live: false },
+    }
+}
+
+declare_params! {
+    /// Impedance of a 3-row acceleration task, interactive-force-control paper eq. (4)/(5):
+    /// diagonals of `Λ`, `K`, `D`.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct Impedance3 {
+        /// Diagonal of `Λ` (kg m² for rotations).
+        pub lambda: [f64; 3] => { unit: "kg", range: Range::positive(1e3), live: false },
+        /// Diagonal of `K` (N m/rad, or N per signal unit on a skin signal).
+        pub k: [f64; 3] => { unit: "N/m", range: Range::closed(0.0, 1e5), live: false },
+        /// Diagonal of `D` (N m s/rad for rotations).
+        pub d: [f64; 3] => { unit: "N s/m", range: Range::closed(0.0, 1e4), live: false },
+    }
+}
+
+declare_params! {
+    /// Interactive-force-control paper eq. (15)-(17): mobile-base collision avoidance from laser points.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct BaseAvoidanceParams {
+        /// `f_max` of eq. (16).
+        pub f_max_n: f64 => { unit: "N", range: Range::closed(0.0, 1e3), live: false },
+        /// `α` of eq. (16).
+        pub alpha_m: f64 => { unit: "m", range: Range::positive(10.0), live: false },
+        /// Points farther than this from the footprint are ignored.
+        pub range_m: f64 => { unit: "m", range: Range::closed(0.0, 30.0), live: false },
+        /// Footprint rectangle in the base frame: `[x_min, x_max]`.
+        pub footprint_x_m: [f64; 2] => { unit: "m", range: Range::closed(-10.0, 10.0), live: false },
+        /// Footprint rectangle in the base frame: `[y_min, y_max]`.
+        pub footprint_y_m: [f64; 2] => { unit: "m", range: Range::closed(-10.0, 10.0), live: false },
+        /// Angular sectors (about the base origin); the closest point of each sector is one `o_i`.
+        pub sectors: usize => { unit: "", range: Range::closed(1.0, 360.0), live: false },
+    }
+}
+
+declare_params! {
+    /// Interactive-force-control paper eq. (18): joint compliance / posture.
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct PostureParams {
+        /// `K_c` diagonal, one per joint or one value for all (N/m on prismatic joints).
+        pub k_c: Vec<f64> => { unit: "N m/rad", range: Range::closed(0.0, 1e5), live: false },
+        /// `D_c` diagonal, one per joint or one value for all (N s/m on prismatic joints).
+        pub d_c: Vec<f64> => { unit: "N m s/rad", range: Range::closed(0.0, 1e4), live: false },
+        /// Gain `k_skin` on the body skin torque `τ_skin` (eq. 14) inside `τ_s`.
+        pub skin_gain: f64 => { unit: "N per signal unit", range: Range::closed(0.0, 1e3), live: false },
+        /// `K_c`, `D_c` of the base joints (x, y, yaw) at rest, replacing `k_c`, `d_c` there (none:
+        /// `k_c`, `d_c`): the base's virtual mass is far larger than an arm joint's inertia, so the
+        /// arm's damping leaves it ringing after a touch.
+        #[serde(default)]
+        pub base: Option<BaseGains> => nested,
+        /// `K_c`, `D_c` of the base joints while they track a commanded base motion
+        /// (`tasks::posture::BaseReference`); none: the base joints' gains at rest.
+        #[serde(default)]
+        pub base_tracking: Option<BaseGains> => nested,
+    }
+}
+
+declare_params! {
+    /// Gains of the base joints (world x, y, yaw) in the posture torque of eq. (18): at rest, or
+    /// toward a commanded base motion (stiffer than the posture's, so that the lowest level follows
+    /// the motion against the arm's own posture pull).
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct BaseGains {
+        /// Stiffness along x, y (N m/rad about yaw).
+        pub k_c: [f64; 3] => { unit: "N/m", range: Range::closed(0.0, 1e5), live: false },
+        /// Damping along x, y (N m s/rad about yaw).
+        pub d_c: [f64; 3] => { unit: "N s/m", range: Range::closed(0.0, 1e4), live: false },
+    }
+}
+
+declare_params! {
+    /// Every task's parameters (`config/tasks.yaml`).
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct TaskParams {
+        /// End-effector position goal (intentional-contact paper eq. 7-9).
+        pub goal: GoalParams => nested,
+        /// End-effector orientation goal (same law, angular rows).
+        pub goal_orientation: GoalParams => nested,
+        /// Proximity avoidance (intentional-contact paper eq. 3).
+        pub avoidance: AvoidanceParams => nested,
+        /// Contact reaction (intentional-contact paper eq. 6).
+        pub contact_reaction: ContactReactionParams => nested,
+        /// Hand force/distance (interactive-force-control paper eq. 9).
+        pub hand_force: HandForceParams => nested,
+        /// Compliant wrist (interactive-force-control paper eq. 10).
+        pub wrist: Impedance3 => nested,
+        /// Tactile guidance (interactive-force-control paper eq. 11-12).
+        pub tactile_guidance: Impedance3 => nested,
+        /// Cartesian position hold (interactive-force-control paper eq. 4, Table 1).
+        pub position_hold: Impedance3 => nested,
+        /// Base collision avoidance (interactive-force-control paper eq. 15-17).
+        pub base_avoidance: BaseAvoidanceParams => nested,
+        /// Joint compliance / posture (interactive-force-control paper eq. 18).
+        pub posture: PostureParams => nested,
     }
 }
 
 impl TaskParams {
-    /// Checks every value; the error key is the dotted path in the file.
+    /// Checks every value: the declared ranges, then what relates two values; the error key is
+    /// the dotted path in the file.
     pub fn validate(&self) -> Result<(), InvalidParam> {
-        self.goal.validate("goal.")?;
-        self.goal_orientation.validate("goal_orientation.")?;
-        pos("avoidance.", "gain_n_per_m", self.avoidance.gain_n_per_m)?;
-        nonneg("avoidance.", "range_m", self.avoidance.range_m)?;
-        nonneg("avoidance.", "activation_band_m", self.avoidance.activation_band_m)?;
-        nonneg("contact_reaction.", "gain", self.contact_reaction.gain)?;
-        nonneg("contact_reaction.", "activation_force_n", self.contact_reaction.activation_force_n)?;
-        let h = &self.hand_force;
-        pos("hand_force.", "lambda_kg", h.lambda_kg)?;
-        nonneg("hand_force.", "k_force_n_per_signal", h.k_force_n_per_signal)?;
-        nonneg("hand_force.", "k_distance_n_per_m", h.k_distance_n_per_m)?;
-        nonneg("hand_force.", "d_n_s_per_m", h.d_n_s_per_m)?;
-        InvalidParam::in_range(
-            "hand_force.",
-            "force_signal_desired",
-            h.force_signal_desired,
-            0.0,
-            f64::MAX,
-            "must be finite and >= 0",
-        )?;
-        nonneg("hand_force.", "distance_desired_m", h.distance_desired_m)?;
-        pos("hand_force.", "approach_time_s", h.approach_time_s)?;
-        pos("hand_force.", "approach_speed_min_mps", h.approach_speed_min_mps)?;
-        self.wrist.validate("wrist.")?;
-        self.tactile_guidance.validate("tactile_guidance.")?;
-        self.position_hold.validate("position_hold.")?;
+        self.check("")?;
         let b = &self.base_avoidance;
-        nonneg("base_avoidance.", "f_max_n", b.f_max_n)?;
-        pos("base_avoidance.", "alpha_m", b.alpha_m)?;
-        nonneg("base_avoidance.", "range_m", b.range_m)?;
         for (name, r) in [("footprint_x_m", b.footprint_x_m), ("footprint_y_m", b.footprint_y_m)] {
             InvalidParam::in_range(
                 "base_avoidance.",
@@ -230,30 +196,13 @@ impl TaskParams {
                 "must be finite and >= the minimum",
             )?;
         }
-        InvalidParam::in_range("base_avoidance.", "sectors", b.sectors as f64, 1.0, 360.0, "must be in [1, 360]")?;
-        let p = &self.posture;
-        for (name, v) in [("k_c", &p.k_c), ("d_c", &p.d_c)] {
+        for (name, v) in [("k_c", &self.posture.k_c), ("d_c", &self.posture.d_c)] {
             if v.is_empty() {
-                return Err(InvalidParam {
-                    key: format!("posture.{name}"),
-                    value: 0.0,
-                    reason: "needs at least one value",
-                });
-            }
-            for (i, x) in v.iter().enumerate() {
-                nonneg("posture.", &format!("{name}[{i}]"), *x)?;
+                let reason = "needs at least one value".into();
+                return Err(InvalidParam { key: format!("posture.{name}"), value: 0.0, reason });
             }
         }
-        for (prefix, gains) in [("posture.base.", &p.base), ("posture.base_tracking.", &p.base_tracking)] {
-            if let Some(b) = gains {
-                for (name, v) in [("k_c", b.k_c), ("d_c", b.d_c)] {
-                    for (i, x) in v.iter().enumerate() {
-                        nonneg(prefix, &format!("{name}[{i}]"), *x)?;
-                    }
-                }
-            }
-        }
-        nonneg("posture.", "skin_gain", p.skin_gain)
+        Ok(())
     }
 
     /// Parses and validates `text`; `source` names the file in errors.

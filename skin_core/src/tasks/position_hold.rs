@@ -6,6 +6,7 @@ use nalgebra::{Point3, Vector3};
 
 use super::params::Impedance3;
 use super::point_rows::{PointRows, LINEAR};
+use super::task::{Cycle, Role, Rows, Task, TaskSetup};
 use super::{impedance_acceleration, TaskError};
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
@@ -49,5 +50,27 @@ impl PositionHold {
         let xdd = impedance_acceleration(&self.params, &(self.target - x), &v);
         self.rows.set_acceleration(level, LINEAR, &xdd)?;
         Ok(xdd)
+    }
+}
+
+impl Task for PositionHold {
+    fn name() -> &'static str {
+        "position_hold"
+    }
+
+    fn role() -> Role {
+        Role::Level(Rows::Fixed(3))
+    }
+
+    fn build(s: &TaskSetup) -> Result<Self, TaskError> {
+        Ok(Self::new(s.model.nv(), s.end_effector, Vector3::zeros(), s.params.position_hold))
+    }
+
+    fn fill(&mut self, cx: &Cycle, level: &mut TaskLevel) -> Result<(), TaskError> {
+        self.update(cx.model, cx.data, level).map(drop)
+    }
+
+    fn on_switch(&mut self, data: &ModelData) {
+        self.capture(data);
     }
 }

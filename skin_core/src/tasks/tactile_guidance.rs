@@ -10,6 +10,7 @@ use nalgebra::Vector3;
 
 use super::params::Impedance3;
 use super::point_rows::{PointRows, LINEAR};
+use super::task::{Cycle, Role, Rows, Task, TaskSetup};
 use super::{impedance_acceleration, TaskError};
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
@@ -45,5 +46,23 @@ impl TactileGuidance {
         let xdd = r * impedance_acceleration(&self.params, &(-arm_force_hand), &v_h);
         self.rows.set_acceleration(level, LINEAR, &xdd)?;
         Ok(xdd)
+    }
+}
+
+impl Task for TactileGuidance {
+    fn name() -> &'static str {
+        "tactile_guidance"
+    }
+
+    fn role() -> Role {
+        Role::Level(Rows::Fixed(3))
+    }
+
+    fn build(s: &TaskSetup) -> Result<Self, TaskError> {
+        Ok(Self::new(s.model.nv(), s.end_effector, s.params.tactile_guidance))
+    }
+
+    fn fill(&mut self, cx: &Cycle, level: &mut TaskLevel) -> Result<(), TaskError> {
+        self.update(cx.model, cx.data, &cx.hand.guidance_force, level).map(drop)
     }
 }

@@ -7,6 +7,7 @@ use nalgebra::{DMatrix, DVector, Matrix6xX, Point3, UnitQuaternion, Vector2, Vec
 
 use super::avoidance::ProximityAvoidance;
 use super::base_avoidance::BaseAvoidance;
+use super::compliance::BodyCompliance;
 use super::contact_reaction::ContactReaction;
 use super::goal::{saturated_goal_force, GoalOrientation, GoalPosition};
 use super::hand_force::{HandForce, HandMeasurement};
@@ -15,7 +16,6 @@ use super::position_hold::PositionHold;
 use super::posture::{BaseReference, Posture};
 use super::tactile_guidance::TactileGuidance;
 use super::wrist::CompliantWrist;
-use super::TaskError;
 use crate::hierarchy::{HierarchySolver, InverseParams, TaskLevel};
 use crate::model::{crba, point_jacobian, update_kinematics, ModelData, RobotModel};
 use crate::param_file::ParamsError;
@@ -365,9 +365,9 @@ fn posture_at_rest_posture_is_pure_damping() {
     let nv = s.model.nv();
     let qd: Vec<f64> = (0..nv).map(|i| 0.1 * i as f64 - 0.5).collect();
     update_kinematics(&s.model, &mut s.data, &s.q, &qd).unwrap();
-    let mut posture = Posture::new(nv, &s.params.posture, &s.q).unwrap();
-    let wrenches = vec![PatchWrench::default(); s.layout.patches().len()];
-    let tau = posture.update(&s.model, &s.data, &s.layout, &wrenches, |_| true, None, true).unwrap().clone();
+    let posture = Posture::new(nv, &s.params.posture, &s.q).unwrap();
+    let mut tau = DVector::zeros(nv);
+    posture.joint_torque(&s.data, None, &mut tau).unwrap();
     for i in 0..nv {
         assert_relative_eq!(tau[i], -posture.d_c[i] * qd[i], epsilon = 1e-12);
     }
@@ -380,12 +380,11 @@ fn a_base_reference_replaces_q_post_on_the_base_joints_only() {
     let joints = ["base_x_joint", "base_y_joint", "base_yaw_joint"].map(|n| s.model.joint_index(n).unwrap());
     let qd: Vec<f64> = (0..nv).map(|i| 0.02 * i as f64 - 0.1).collect();
     update_kinematics(&s.model, &mut s.data, &s.q, &qd).unwrap();
-    let mut posture = Posture::new(nv, &s.params.posture, &s.q).unwrap();
+    let posture = Posture::new(nv, &s.params.posture, &s.q).unwrap();
     let gains = s.params.posture.base_tracking.expect("config/tasks.yaml has base tracking gains");
-    let wrenches = vec![PatchWrench::default(); s.layout.patches().len()];
     let reference = BaseReference { position: [0.1, -0.2, 0.05], velocity: [0.03, 0.01, -0.02] };
-    posture.set_base_reference(joints, Some(reference)).unwrap();
-    let tau = posture.update(&s.model, &s.data, &s.layout, &wrenches, |_| true, None, true).unwrap().clone();
+    let mut tau = DVector::zeros(nv);
+    posture.joint_torque(&s.data, Some((joints, reference)), &mut tau).unwrap();
     for i in 0..nv {
         let expected = match joints.iter().position(|&j| j == i) {
             // eq. (18) with q_d(t), q̇_d(t) and the tracking gains
@@ -396,12 +395,8 @@ fn a_base_reference_replaces_q_post_on_the_base_joints_only() {
         };
         assert_relative_eq!(tau[i], expected, epsilon = 1e-12);
     }
-    let bad = BaseReference { position: [0.0, f64::INFINITY, 0.0], ..reference };
-    assert!(matches!(posture.set_base_reference(joints, Some(bad)), Err(TaskError::NonFinite { index: 1, .. })));
-    assert!(posture.set_base_reference([0, 1, nv], None).is_err());
-    posture.set_base_reference(joints, None).unwrap();
-    let tau = posture.update(&s.model, &s.data, &s.layout, &wrenches, |_| true, None, true).unwrap()[joints[0]];
-    assert_relative_eq!(tau, -posture.d_c[joints[0]] * qd[joints[0]], epsilon = 1e-12);
+    posture.joint_torque(&s.data, None, &mut tau).unwrap();
+    assert_relative_eq!(tau[joints[0]], -posture.d_c[joints[0]] * qd[joints[0]], epsilon = 1e-12);
 }
 
 #[test]
@@ -424,8 +419,9 @@ fn base_avoidance_pushes_back_with_eq17_yaw_term() {
     posture.k_c.fill(0.0);
     let mut data = ModelData::new(&s.model);
     update_kinematics(&s.model, &mut data, &q, &vec![0.0; nv]).unwrap();
-    let wrenches = vec![PatchWrench::default(); s.layout.patches().len()];
-    let tau = posture.update(&s.model, &data, &s.layout, &wrenches, |_| true, Some(base.torque()), true).unwrap();
+    let mut tau = DVector::zeros(nv);
+    posture.joint_torque(&data, None, &mut tau).unwrap();
+    tau -= base.torque();
     assert!(tau[joints[0]] < 0.0);
     assert_relative_eq!(tau[joints[2]], y * f, epsilon = 1e-12);
     // with the base turned by 90°, "backward" is world −y
@@ -452,7 +448,8 @@ fn three_tasks_and_posture_through_the_solver() {
     let mut hand_task = HandForce::new(nv, hand, s.params.hand_force);
     let mut hold = PositionHold::new(nv, hand, Vector3::zeros(), s.params.position_hold);
     hold.capture(&s.data);
-    let mut posture = Posture::new(nv, &s.params.posture, &vec![0.0; nv]).unwrap();
+    let posture = Posture::new(nv, &s.params.posture, &vec![0.0; nv]).unwrap();
+    let mut compliance = BodyCompliance::new(nv, s.params.posture.skin_gain);
     let mut levels = [TaskLevel::new("avoid", nv, n), TaskLevel::new("hand", nv, 1), TaskLevel::new("hold", nv, 3)];
     let [l0, l1, l2] = &mut levels;
     let sum = avoid
@@ -463,7 +460,10 @@ fn three_tasks_and_posture_through_the_solver() {
         .update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.1 }, 0.0, &s.skin.proximity, l1)
         .unwrap();
     hold.update(&s.model, &s.data, l2).unwrap();
-    let tau_c = posture.update(&s.model, &s.data, &s.layout, &wrenches, |_| true, None, true).unwrap().clone();
+    let (mut tau_s, mut tau_c) = (DVector::zeros(nv), DVector::zeros(nv));
+    compliance.add_to(&s.model, &s.data, &s.layout, &wrenches, |_| true, &mut tau_s).unwrap();
+    posture.joint_torque(&s.data, None, &mut tau_c).unwrap();
+    tau_c -= &tau_s;
     let mut solver = HierarchySolver::new(nv, 3, n, InverseParams::default()).unwrap();
     let mut tau = DVector::zeros(nv);
     solver.solve_model(&s.model, &mut s.data, levels.iter(), Some(tau_c.as_slice()), true, &mut tau).unwrap();

@@ -11,6 +11,7 @@ use nalgebra::Vector3;
 
 use super::params::Impedance3;
 use super::point_rows::{PointRows, ANGULAR};
+use super::task::{Cycle, Role, Rows, Task, TaskSetup};
 use super::{impedance_acceleration, TaskError};
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
@@ -46,5 +47,23 @@ impl CompliantWrist {
         let xdd = impedance_acceleration(&self.params, &(-moment_world), &w);
         self.rows.set_acceleration(level, ANGULAR, &xdd)?;
         Ok(xdd)
+    }
+}
+
+impl Task for CompliantWrist {
+    fn name() -> &'static str {
+        "wrist"
+    }
+
+    fn role() -> Role {
+        Role::Level(Rows::Fixed(3))
+    }
+
+    fn build(s: &TaskSetup) -> Result<Self, TaskError> {
+        Ok(Self::new(s.model.nv(), s.end_effector, s.params.wrist))
+    }
+
+    fn fill(&mut self, cx: &Cycle, level: &mut TaskLevel) -> Result<(), TaskError> {
+        self.update(cx.model, cx.data, &cx.hand.moment_world, level).map(drop)
     }
 }

@@ -12,7 +12,7 @@ MSG_SRCS := $(wildcard skin_msgs/msg/*.msg skin_msgs/srv/*.srv) skin_msgs/CMakeL
 MSG_SRCS += $(wildcard $(DEPS)/ros/install/.ros2-jazzy-python.stamp)
 CARGO_PROFILE ?= dev
 
-.PHONY: help bootstrap msgs build lint test test-rust test-robot-package test-integration run demo bench study clean fuzz test-fuzz
+.PHONY: help bootstrap msgs build lint test test-rust test-robot-package test-integration run demo bench study campaign clean fuzz test-fuzz
 
 help:
 	@echo "make demo   bootstrap, build, run the main job: the intentional_contact scenario (see README.md)"
@@ -20,6 +20,7 @@ help:
 	@echo "make test   bootstrap, build, run every test suite (cargo tests + test/ integration tests)"
 	@echo "make fuzz   fuzz skin_core with libFuzzer on stable, FUZZ_SECONDS per target (default 600; docs/fuzzing.md)"
 	@echo "make bench  run the benchmarks; figures in out/bench/summary.json"
+	@echo "make campaign  randomized scene campaign (200 scenes): out/campaign/summary.json, docs/robustness.md"
 	@echo "make study  speed/accuracy study (rate, timestep, skin density, inverse damping): out/study/results.json,"
 	@echo "            docs/tradeoffs.md and docs/tradeoffs/*.png; STUDY_ARGS=--full for the whole grid (long)"
 	@echo "make clean  remove build outputs (keeps .deps; rm -rf .deps for a full reset)"
@@ -95,6 +96,13 @@ STUDY_ARGS ?=
 study: bootstrap
 	@echo "[make] skin_sim sweep $(STUDY_ARGS)"
 	@$(ENV) cargo run --quiet -p skin_sim --bin skin_sim -- sweep --out out/study --doc docs/tradeoffs.md $(STUDY_ARGS)
+
+# The randomized scene campaign (docs/robustness.md): 200 scenes from seed 1 on every core,
+# ~5 min on 2 cores with the debug profile; CAMPAIGN_ARGS="--scenes 400 --seed 2" for others.
+CAMPAIGN_ARGS ?=
+campaign: bootstrap
+	@echo "[make] skin_sim campaign $(CAMPAIGN_ARGS)"
+	@$(ENV) cargo run --quiet -p skin_sim --bin skin_sim -- campaign --out out/campaign --doc docs/robustness.md $(CAMPAIGN_ARGS)
 
 clean:
 	cargo clean

@@ -19,6 +19,7 @@
 #![warn(missing_docs)]
 
 pub mod base_motion;
+pub mod campaign;
 mod cell_face;
 pub mod closed_loop;
 mod frames;

@@ -26,8 +26,13 @@ impl Noise {
     }
 
     /// Uniform in (0, 1]: never 0, so that its logarithm is finite.
-    fn uniform(&mut self) -> f64 {
+    pub fn uniform(&mut self) -> f64 {
         ((self.next_u64() >> 11) + 1) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Uniform in `(lo, hi]`.
+    pub fn between(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.uniform()
     }
 
     /// A normal sample with standard deviation `std` (0: exactly 0, no draw).

@@ -63,6 +63,35 @@ enum Command {
     /// Run the speed/accuracy study over control rate, timestep, skin density and the inverse's
     /// damping; write results.json and generate the document with its figures.
     Sweep(SweepArgs),
+    /// Run the randomized scene campaign: scenes varied from a seed, judged for safety and
+    /// success; writes results.json, summary.json and docs/robustness.md. Exit code 1 when a
+    /// scene has a safety violation.
+    Campaign(CampaignArgs),
+}
+
+#[derive(clap::Args)]
+struct CampaignArgs {
+    /// Number of scenes (they cycle through the families).
+    #[arg(long, default_value_t = 200)]
+    scenes: usize,
+    /// Seed of the campaign: the same seed gives the same scenes.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Worker threads [default: the machine's cores].
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Run only this scene (its full outputs go into <out>/<id>/).
+    #[arg(long)]
+    only: Option<usize>,
+    /// Output directory: results.json, summary.json.
+    #[arg(long, default_value = "out/campaign")]
+    out: PathBuf,
+    /// The generated document.
+    #[arg(long, default_value = "docs/robustness.md")]
+    doc: PathBuf,
+    /// No progress lines on stderr.
+    #[arg(long)]
+    quiet: bool,
 }
 
 #[derive(clap::Args)]
@@ -198,6 +227,7 @@ fn run(args: Command) -> anyhow::Result<bool> {
             return Ok(true);
         }
         Command::Sweep(args) => return sweep(args),
+        Command::Campaign(args) => return campaign(args),
         Command::Run { target, out, controller, duration, control_rate, dt, seed, quiet, video } => {
             (target, out, controller, duration, control_rate, dt, seed, quiet, video)
         }
@@ -218,6 +248,39 @@ fn run(args: Command) -> anyhow::Result<bool> {
     let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
     println!("  wrote {}", names.join(", "));
     Ok(report.passed())
+}
+
+/// `skin_sim campaign`: the whole campaign, or one scene of it (`--only`).
+fn campaign(args: CampaignArgs) -> anyhow::Result<bool> {
+    use skin_sim::campaign;
+    if let Some(id) = args.only {
+        let s = campaign::scene(args.seed, id).map_err(anyhow::Error::msg)?;
+        let dir = args.out.join(id.to_string());
+        let r = campaign::run_scene(&s, Some(&dir));
+        println!("scene {id} ({}): drawn {}", r.family, r.drawn);
+        let failures = campaign::failures(&r);
+        println!(
+            "{} (outputs in {})",
+            if failures.is_empty() { "ok".to_string() } else { failures.join("; ") },
+            dir.display()
+        );
+        return Ok(failures.is_empty());
+    }
+    let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let total = args.scenes;
+    let (results, summary) = campaign::run(args.seed, total, jobs, |done, r| {
+        if !args.quiet {
+            let failures = campaign::failures(r);
+            let status = if failures.is_empty() { "ok".to_string() } else { failures.join("; ") };
+            eprintln!("[{done}/{total}] scene {} ({}) {:.1} s: {status}", r.id, r.family, r.wall_s);
+        }
+    });
+    let files = campaign::write(&args.out, Some(&args.doc), &results, &summary)?;
+    println!("{}", serde_json::to_string_pretty(&summary)?);
+    for f in files {
+        println!("wrote {}", f.display());
+    }
+    Ok(summary.safety_violations == 0 && summary.errors == 0)
 }
 
 fn main() -> ExitCode {

@@ -1,0 +1,157 @@
+//! The randomized scene families of the campaign, each a shipped scenario's scene varied from a
+//! seed: what the controller was not tuned on.
+
+use serde_json::{json, Value};
+
+use crate::noise::Noise;
+use crate::scene::spec::{ObjectSpec, SceneSpec, ShapeSpec};
+
+/// Standard gravity \[m/s²\].
+const G: f64 = 9.81;
+
+/// A scene family.
+#[derive(Debug, Clone, Copy)]
+pub struct Family {
+    /// Name in the results.
+    pub name: &'static str,
+    /// The scenario whose scene and controller it varies.
+    pub scenario: &'static str,
+    /// Varies `spec`; returns what was drawn.
+    pub vary: fn(&mut Noise, &mut SceneSpec) -> Value,
+}
+
+/// Every family, in the order scenes cycle through them.
+pub const FAMILIES: [Family; 4] = [
+    Family { name: "planar_contact", scenario: "intentional_contact", vary: planar_contact },
+    Family { name: "tomm_reach", scenario: "tomm_movable_obstacles", vary: tomm_reach },
+    Family { name: "force_tracking", scenario: "force_tracking_base_motion", vary: force_tracking },
+    Family { name: "tactile_guidance", scenario: "tactile_guidance", vary: tactile_guidance },
+];
+
+/// Whether every movable object of `spec` slides under `eps_c` (Coulomb friction `μ m g`), and
+/// none is fixed: the goal is then reachable by pushing (intentional-contact paper Sec. IV).
+pub fn feasible(spec: &SceneSpec, eps_c_n: f64, pushed: &[&str]) -> bool {
+    spec.objects
+        .iter()
+        .filter(|o| pushed.contains(&o.name.as_str()))
+        .all(|o| o.mass_kg.is_some_and(|m| o.friction * m * G < eps_c_n))
+}
+
+/// Movable with probability `1 - p_fixed`: a mass in `[lo, hi]` kg, or fixed (`None`).
+fn mass(rng: &mut Noise, p_fixed: f64, lo: f64, hi: f64) -> Option<f64> {
+    (rng.uniform() > p_fixed).then(|| rng.between(lo, hi))
+}
+
+/// The planar arm pushes an obstacle between it and its goal (intentional-contact paper Figs.
+/// 2-3): obstacle position, size, mass 0.2-3 kg or fixed, friction, a second obstacle, start
+/// posture, goal, skin noise.
+fn planar_contact(rng: &mut Noise, spec: &mut SceneSpec) -> Value {
+    let (dx, dy) = (rng.between(-0.08, 0.08), rng.between(-0.03, 0.05));
+    let radius = rng.between(0.07, 0.12);
+    let mass_kg = mass(rng, 0.2, 0.2, 3.0);
+    let friction = rng.between(0.1, 0.4);
+    let obstacle = &mut spec.objects[0];
+    obstacle.xyz[0] += dx;
+    obstacle.xyz[1] += dy - (radius - 0.1); // the same gap to the goal below it
+    obstacle.shape = ShapeSpec::Cylinder { radius_m: radius, length_m: 0.6 };
+    obstacle.mass_kg = mass_kg;
+    obstacle.friction = friction;
+    if mass_kg.is_none() {
+        spec.pushes.clear(); // nothing pushes a fixed obstacle into the arm
+    }
+    let second = rng.uniform() < 0.3;
+    if second {
+        let side = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+        let mut o: ObjectSpec = spec.objects[0].clone();
+        o.name = "second_obstacle".into();
+        o.shape = ShapeSpec::Cylinder { radius_m: 0.05, length_m: 0.6 };
+        o.xyz = [1.0 + side * rng.between(0.25, 0.35), -0.62, 0.0];
+        o.mass_kg = Some(0.5);
+        spec.objects.push(o);
+    }
+    let posture: Vec<f64> = spec
+        .robot
+        .initial
+        .values_mut()
+        .map(|q| {
+            let d = rng.between(-0.1, 0.1);
+            *q += d;
+            d
+        })
+        .collect();
+    let goal = [rng.between(-0.03, 0.03), rng.between(-0.02, 0.0)];
+    spec.goals[0].position_m[0] += goal[0];
+    spec.goals[0].position_m[1] += goal[1];
+    let noise = rng.between(0.0, 0.02);
+    if let Some(skin) = &mut spec.skin {
+        skin.proximity_noise_std = noise;
+        skin.force_noise_std = noise;
+    }
+    spec.seed = rng.uniform().to_bits() % 1000;
+    json!({"obstacle_shift_m": [dx, dy], "radius_m": radius, "mass_kg": mass_kg, "friction": friction,
+           "second_obstacle": second, "posture_shift_rad": posture, "goal_shift_m": goal, "skin_noise_std": noise})
+}
+
+/// TOMM's right arm reaches over a table through two movable obstacles (intentional-contact
+/// paper Fig. 5): obstacle shifts, masses and friction.
+fn tomm_reach(rng: &mut Noise, spec: &mut SceneSpec) -> Value {
+    let mut drawn = Vec::new();
+    for o in spec.objects.iter_mut().filter(|o| o.mass_kg.is_some()) {
+        let (dx, dy) = (rng.between(-0.05, 0.05), rng.between(-0.05, 0.05));
+        o.xyz[0] += dx;
+        o.xyz[1] += dy;
+        o.mass_kg = Some(rng.between(0.2, 2.0));
+        o.friction = rng.between(0.1, 0.4);
+        drawn.push(json!({"name": o.name, "shift_m": [dx, dy], "mass_kg": o.mass_kg, "friction": o.friction}));
+    }
+    spec.seed = rng.uniform().to_bits() % 1000;
+    json!({ "obstacles": drawn })
+}
+
+/// The hand tracks a sinusoidal force on a board while the base moves (interactive-force-control
+/// paper Exp. 1): reference mean 2-8 N, amplitude, period 2-8 s, board tilt ±10°, circle radius.
+fn force_tracking(rng: &mut Noise, spec: &mut SceneSpec) -> Value {
+    let mean = rng.between(2.0, 8.0);
+    let amplitude = rng.between(0.0, 2.0_f64.min(mean - 1.0));
+    let period = rng.between(2.0, 8.0);
+    let (pitch, yaw) = (rng.between(-10.0, 10.0), rng.between(-10.0, 10.0));
+    let radius = rng.between(0.0, 0.3);
+    let r = &mut spec.force_references[0];
+    (r.mean_n, r.amplitude_n, r.period_s) = (mean, amplitude, Some(period));
+    spec.objects[0].rpy = [0.0, pitch.to_radians(), yaw.to_radians()];
+    spec.base_motions.truncate(1);
+    spec.duration_s = 45.0;
+    let m = &mut spec.base_motions[0];
+    m.end_s = spec.duration_s;
+    if let Some(c) = &mut m.circle {
+        c.radius_m = radius;
+    }
+    spec.seed = rng.uniform().to_bits() % 1000;
+    json!({"mean_n": mean, "amplitude_n": amplitude, "period_s": period, "tilt_deg": [pitch, yaw], "circle_radius_m": radius})
+}
+
+/// Touches on the arm guide the hand (interactive-force-control paper Exp. 2): which link is
+/// touched, how hard and when.
+fn tactile_guidance(rng: &mut Noise, spec: &mut SceneSpec) -> Value {
+    let mut drawn = Vec::new();
+    for p in &mut spec.pushes {
+        let scale = rng.between(0.6, 1.2);
+        let shift = rng.between(-3.0, 3.0);
+        if rng.uniform() < 0.5 {
+            p.link = Some(
+                if p.link.as_deref() == Some("right_forearm_link") {
+                    "right_upper_arm_link"
+                } else {
+                    "right_forearm_link"
+                }
+                .into(),
+            );
+        }
+        p.force_n = p.force_n.map(|f| f * scale);
+        p.start_s += shift;
+        p.end_s += shift;
+        drawn.push(json!({"link": p.link, "force_scale": scale, "time_shift_s": shift}));
+    }
+    spec.seed = rng.uniform().to_bits() % 1000;
+    json!({ "touches": drawn })
+}

@@ -1,0 +1,302 @@
+//! `skin_sim campaign`: hundreds of randomized scenes ([`families`]) from one seed, run in
+//! parallel, judged for safety and success ([`verdict`]), written to `results.json`,
+//! `summary.json` and `docs/robustness.md` (every failure with the seed and the command that
+//! reruns it).
+
+pub mod families;
+pub mod verdict;
+
+#[cfg(test)]
+mod tests;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::Serialize;
+use serde_json::Value;
+
+use crate::noise::Noise;
+use crate::report::{write_all, MetricsJson, SummaryText};
+use crate::runner::RunTarget;
+use crate::scenario;
+use crate::scene::spec::SceneSpec;
+use crate::scene::Scene;
+use crate::study::pool;
+use families::{Family, FAMILIES};
+use verdict::{judge, overshoot_ok, Verdict};
+
+/// `ε_c` the feasibility of a push is judged with \[N\] (config/supervisor.yaml).
+const EPS_C_N: f64 = 5.0;
+
+/// One generated scene.
+#[derive(Debug, Clone)]
+pub struct CampaignScene {
+    /// Index in the campaign.
+    pub id: usize,
+    /// Its family.
+    pub family: Family,
+    /// What was drawn.
+    pub drawn: Value,
+    /// Whether the goal can be reached by pushing under `ε_c`.
+    pub feasible: bool,
+    /// The scene file it varies, and the scene.
+    target: RunTarget,
+    spec: SceneSpec,
+}
+
+/// Scene `id` of the campaign with `seed`: the same pair always gives the same scene.
+pub fn scene(seed: u64, id: usize) -> Result<CampaignScene, String> {
+    let family = FAMILIES[id % FAMILIES.len()];
+    let sc = scenario::find(family.scenario).ok_or_else(|| format!("no scenario {}", family.scenario))?;
+    let target = RunTarget::from(sc);
+    let (text, file) = skin_core::param_file::yaml::read_text(&target.scene).map_err(|e| e.to_string())?;
+    let mut spec: SceneSpec = skin_core::param_file::yaml::parse_str(&text, &file).map_err(|e| e.to_string())?;
+    let mut rng = Noise::new(seed, id as u64 + 1);
+    let drawn = (family.vary)(&mut rng, &mut spec);
+    let pushed: Vec<&str> = spec
+        .objects
+        .iter()
+        .filter(|o| o.mass_kg.is_some() || o.name.contains("obstacle"))
+        .map(|o| o.name.as_str())
+        .collect();
+    let feasible = !spec.goals.is_empty() && families::feasible(&spec, EPS_C_N, &pushed);
+    Ok(CampaignScene { id, family, drawn, feasible, target, spec })
+}
+
+/// One scene's row of `results.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct SceneResult {
+    /// Index in the campaign.
+    pub id: usize,
+    /// Family name.
+    pub family: &'static str,
+    /// What was drawn.
+    pub drawn: Value,
+    /// Whether the goal can be reached by pushing under `ε_c`.
+    pub feasible: bool,
+    /// The run failed to start (a scene error) or ran.
+    pub error: Option<String>,
+    /// What it showed.
+    pub verdict: Option<Verdict>,
+    /// Its metrics.
+    pub metrics: Option<Value>,
+    /// Wall-clock time of the run \[s\].
+    pub wall_s: f64,
+}
+
+/// Runs `s`; `out`: also write the run's own outputs there.
+pub fn run_scene(s: &CampaignScene, out: Option<&Path>) -> SceneResult {
+    let start = Instant::now();
+    let mut result = SceneResult {
+        id: s.id,
+        family: s.family.name,
+        drawn: s.drawn.clone(),
+        feasible: s.feasible,
+        error: None,
+        verdict: None,
+        metrics: None,
+        wall_s: 0.0,
+    };
+    let text = serde_json::to_string(&s.spec).expect("a scene spec serializes"); // JSON is YAML
+    let dir = s.target.scene.parent().unwrap_or(Path::new("."));
+    let run = Scene::from_yaml_str(&text, &format!("campaign scene {} ({})", s.id, s.family.name), dir)
+        .map_err(|e| e.to_string())
+        .and_then(|scene| {
+            let model = scene.model.clone();
+            s.target.run_scene(scene, |_| {}).map(|r| (r, model)).map_err(|e| e.to_string())
+        });
+    match run {
+        Ok((report, model)) => {
+            let limits: Vec<f64> = report
+                .record
+                .arm_joints
+                .iter()
+                .map(|n| model.joint_index(n).map_or(f64::INFINITY, |j| model.joint_limits()[j].velocity))
+                .collect();
+            result.verdict = Some(judge(&report, &limits));
+            result.metrics = serde_json::to_value(&report.metrics).ok();
+            if let Some(dir) = out {
+                if let Err(e) = write_all(&report, dir, &[&MetricsJson, &SummaryText]) {
+                    result.error = Some(format!("writing {}: {e}", dir.display()));
+                }
+            }
+        }
+        Err(e) => result.error = Some(e),
+    }
+    result.wall_s = start.elapsed().as_secs_f64();
+    result
+}
+
+/// The flat figures of `summary.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    /// Seed of the campaign.
+    pub seed: u64,
+    /// Scenes run.
+    pub scenes: usize,
+    /// Scenes that could not run (scene errors).
+    pub errors: usize,
+    /// Scenes with at least one safety violation.
+    pub safety_violations: usize,
+    /// Feasible goal scenes (the obstacles slide under `ε_c`) whose goal was reached, fraction.
+    pub goal_success_rate_feasible: f64,
+    /// Force scenes whose interactive-force-control paper Table 3 checks held, fraction.
+    pub force_table3_rate: f64,
+    /// Largest first-contact overshoot of the hand force over its reference \[N\].
+    pub first_contact_overshoot_max_n: f64,
+    /// Scenes per hour of wall-clock time on the cores used.
+    pub campaign_scenes_per_hour: f64,
+    /// Worker threads.
+    pub jobs: usize,
+}
+
+fn rate(hits: impl Iterator<Item = bool>) -> f64 {
+    let (n, k) = hits.fold((0usize, 0usize), |(n, k), h| (n + 1, k + h as usize));
+    if n == 0 {
+        f64::NAN
+    } else {
+        k as f64 / n as f64
+    }
+}
+
+/// The summary of `results`, run on `jobs` threads in `wall_s` seconds.
+pub fn summarize(seed: u64, results: &[SceneResult], wall_s: f64, jobs: usize) -> Summary {
+    let verdicts = || results.iter().filter_map(|r| r.verdict.as_ref().map(|v| (r, v)));
+    Summary {
+        seed,
+        scenes: results.len(),
+        errors: results.iter().filter(|r| r.error.is_some()).count(),
+        safety_violations: verdicts().filter(|(_, v)| !v.violations.is_empty()).count(),
+        goal_success_rate_feasible: rate(verdicts().filter(|(r, _)| r.feasible).filter_map(|(_, v)| v.goal_reached)),
+        force_table3_rate: rate(verdicts().filter_map(|(_, v)| v.force_table3)),
+        first_contact_overshoot_max_n: verdicts()
+            .filter_map(|(_, v)| v.first_contact_overshoot_n)
+            .filter(|x| x.is_finite())
+            .fold(f64::NEG_INFINITY, f64::max),
+        campaign_scenes_per_hour: results.len() as f64 / wall_s * 3600.0,
+        jobs,
+    }
+}
+
+/// Runs scenes `0..n` of the campaign `seed` on `jobs` threads; `done(finished, result)` after
+/// each.
+pub fn run(seed: u64, n: usize, jobs: usize, mut done: impl FnMut(usize, &SceneResult)) -> (Vec<SceneResult>, Summary) {
+    let start = Instant::now();
+    let ids: Vec<usize> = (0..n).collect();
+    let mut finished = 0;
+    let results = pool::map(
+        &ids,
+        jobs,
+        |_, &id| match scene(seed, id) {
+            Ok(s) => run_scene(&s, None),
+            Err(e) => SceneResult {
+                id,
+                family: FAMILIES[id % FAMILIES.len()].name,
+                drawn: Value::Null,
+                feasible: false,
+                error: Some(e),
+                verdict: None,
+                metrics: None,
+                wall_s: 0.0,
+            },
+        },
+        |_, r| {
+            finished += 1;
+            done(finished, r)
+        },
+    );
+    let summary = summarize(seed, &results, start.elapsed().as_secs_f64(), jobs);
+    (results, summary)
+}
+
+/// Why a scene failed, one line (empty: it passed).
+pub fn failures(r: &SceneResult) -> Vec<String> {
+    let mut out: Vec<String> = r.error.iter().map(|e| format!("error: {e}")).collect();
+    if let Some(v) = &r.verdict {
+        out.extend(v.violations.iter().map(|x| format!("safety: {x}")));
+        if r.feasible && v.goal_reached == Some(false) {
+            out.push("goal not reached (feasible)".into());
+        }
+        if v.force_table3 == Some(false) {
+            out.push("Table 3 force error exceeded".into());
+        }
+        if v.first_contact_overshoot_n.is_some_and(|x| !overshoot_ok(x)) {
+            out.push(format!("first-contact overshoot {:.2} N", v.first_contact_overshoot_n.unwrap_or(f64::NAN)));
+        }
+    }
+    out
+}
+
+/// `docs/robustness.md`: the summary, the failure classes per family, and every failing scene
+/// with the command that reruns it.
+pub fn robustness_md(results: &[SceneResult], s: &Summary) -> String {
+    let mut md = format!(
+        "# Robustness: the randomized scene campaign\n\n\
+         Generated by `make campaign` (`skin_sim campaign --scenes {} --seed {} --jobs {}`); do not edit by\n\
+         hand. {} scenes from four families, each a shipped scenario's scene varied from the seed\n\
+         (`skin_sim/src/campaign/families.rs`): planar intentional contact (obstacle position, size,\n\
+         mass 0.2-3 kg or fixed, friction, a second obstacle, start posture, goal, skin noise), TOMM\n\
+         reaching over a table (obstacle shifts, masses, friction), force tracking (reference mean\n\
+         2-8 N, amplitude, period 2-8 s, board tilt ±10°, base circle radius) and tactile guidance\n\
+         (touched link, force, time).\n\n\
+         A safety violation is a non-finite command, a safe-stop cycle, a joint command over its\n\
+         URDF velocity limit, a contact above eps_c for more than 0.5 s in one event, or chatter\n\
+         (3 entries into hard contact within 10 s). A goal scene is feasible when every obstacle\n\
+         slides under eps_c (mu m g < 5 N) and none is fixed.\n\n\
+         | Figure | Value |\n|---|---|\n\
+         | scenes | {} |\n| scenes that could not run | {} |\n| scenes with a safety violation | {} |\n\
+         | goal success, feasible scenes | {:.1} % |\n| force scenes within Table 3 | {:.1} % |\n\
+         | largest first-contact overshoot | {:.2} N |\n| scenes per hour ({} threads) | {:.0} |\n\n\
+         ## Failure classes\n\n| Family | Scenes | Failing | Classes |\n|---|---|---|---|\n",
+        s.scenes,
+        s.seed,
+        s.jobs,
+        s.scenes,
+        s.scenes,
+        s.errors,
+        s.safety_violations,
+        100.0 * s.goal_success_rate_feasible,
+        100.0 * s.force_table3_rate,
+        s.first_contact_overshoot_max_n,
+        s.jobs,
+        s.campaign_scenes_per_hour
+    );
+    for f in FAMILIES {
+        let rows: Vec<&SceneResult> = results.iter().filter(|r| r.family == f.name).collect();
+        let failing: Vec<Vec<String>> = rows.iter().map(|r| failures(r)).filter(|x| !x.is_empty()).collect();
+        let mut classes: Vec<String> = failing
+            .iter()
+            .flatten()
+            .map(|x| x.split(|c: char| c == ':' || c.is_ascii_digit()).next().unwrap_or(x).trim().to_string())
+            .collect();
+        classes.sort();
+        classes.dedup();
+        md += &format!("| {} | {} | {} | {} |\n", f.name, rows.len(), failing.len(), classes.join(", "));
+    }
+    md += "\n## Failing scenes\n\nRerun one with `skin_sim campaign --seed <seed> --only <id>` (outputs in `out/campaign/<id>/`).\n\n";
+    let mut any = false;
+    for r in results {
+        let f = failures(r);
+        if !f.is_empty() {
+            any = true;
+            md += &format!("- scene {} ({}, seed {}): {}; drawn `{}`\n", r.id, r.family, s.seed, f.join("; "), r.drawn);
+        }
+    }
+    if !any {
+        md += "None.\n";
+    }
+    md
+}
+
+/// Writes `results.json` and `summary.json` into `dir`, and the page to `doc` if given.
+pub fn write(dir: &Path, doc: Option<&Path>, results: &[SceneResult], s: &Summary) -> std::io::Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir)?;
+    let mut files = vec![dir.join("results.json"), dir.join("summary.json")];
+    std::fs::write(&files[0], serde_json::to_string_pretty(results).expect("results serialize") + "\n")?;
+    std::fs::write(&files[1], serde_json::to_string_pretty(s).expect("summary serializes") + "\n")?;
+    if let Some(doc) = doc {
+        std::fs::write(doc, robustness_md(results, s))?;
+        files.push(doc.to_path_buf());
+    }
+    Ok(files)
+}

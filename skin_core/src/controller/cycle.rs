@@ -15,8 +15,7 @@ use crate::supervisor::blend::chi;
 use crate::supervisor::{Arrangement, Imposed, Phase, PhaseRefused, Supervisor, SupervisorInput, TorqueBlender};
 use crate::tasks::avoidance::ProximityAvoidance;
 use crate::tasks::contact_reaction::ContactReaction;
-use crate::tasks::posture::BaseReference;
-use crate::tasks::{Cycle, HandSignals, TaskEntry, TaskSetup};
+use crate::tasks::{BaseReference, Cycle, HandSignals, TaskEntry, TaskSetup};
 
 /// Maps a stage's error to [`Fault::Stage`] (the error's text would allocate).
 fn stage<E>(name: &'static str) -> impl FnOnce(E) -> Fault {

@@ -13,7 +13,7 @@ mod task_set;
 #[cfg(test)]
 mod tests;
 
-pub use crate::tasks::posture::BaseReference;
+pub use crate::tasks::BaseReference;
 pub use cycle::Controller;
 pub use hand_force::HandForceMap;
 pub use io::{ControllerInput, ControllerOutput, Fault};

@@ -43,7 +43,7 @@ use thiserror::Error;
 use crate::hierarchy::HierarchyError;
 use crate::model::ModelError;
 use crate::skin::aggregate::LengthMismatch;
-pub use task::{entry, Cycle, HandSignals, Role, Rows, Task, TaskEntry, TaskSetup};
+pub use task::{entry, BaseReference, Cycle, HandSignals, Role, Rows, Task, TaskEntry, TaskSetup};
 
 /// Every task by its name in `config/supervisor.yaml`. A new task is a file with its `impl Task`,
 /// its `mod` line above and one entry here (`docs/tasks.md`).

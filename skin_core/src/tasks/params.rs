@@ -132,7 +132,7 @@ declare_params! {
         #[serde(default)]
         pub base: Option<BaseGains> => nested,
         /// `K_c`, `D_c` of the base joints while they track a commanded base motion
-        /// (`tasks::posture::BaseReference`); none: the base joints' gains at rest.
+        /// (`tasks::BaseReference`); none: the base joints' gains at rest.
         #[serde(default)]
         pub base_tracking: Option<BaseGains> => nested,
     }

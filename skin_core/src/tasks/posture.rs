@@ -12,26 +12,9 @@
 use nalgebra::DVector;
 
 use super::params::{BaseGains, PostureParams};
-use super::task::{Cycle, Role, Task, TaskSetup};
+use super::task::{BaseReference, Cycle, Role, Task, TaskSetup};
 use super::TaskError;
 use crate::model::ModelData;
-
-/// A commanded base pose and velocity at one instant: the moving `q_d`, `q̇_d` of the base joints
-/// (world x, y \[m\], yaw \[rad\], as the base joints measure them; yaw unwrapped like the joint).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct BaseReference {
-    /// `q_d` of base x, y, yaw.
-    pub position: [f64; 3],
-    /// `q̇_d` of base x, y, yaw (world frame) \[m/s, rad/s\].
-    pub velocity: [f64; 3],
-}
-
-impl BaseReference {
-    /// Index of the first non-finite value (positions 0-2, velocities 3-5), if any.
-    pub fn non_finite(&self) -> Option<usize> {
-        self.position.iter().chain(&self.velocity).position(|v| !v.is_finite())
-    }
-}
 
 /// Joint compliance / posture torque.
 #[derive(Debug, Clone)]

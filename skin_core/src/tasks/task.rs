@@ -6,7 +6,6 @@
 use nalgebra::{DVector, Isometry3, Vector2, Vector3};
 
 use super::params::TaskParams;
-use super::posture::BaseReference;
 use super::TaskError;
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
@@ -14,6 +13,23 @@ use crate::skin::aggregate::PatchWrench;
 use crate::skin::layout::ResolvedLayout;
 use crate::skin::live::LiveCells;
 use crate::skin::params::SkinParams;
+
+/// A commanded base pose and velocity at one instant: the moving `q_d`, `q̇_d` of the base joints
+/// (world x, y \[m\], yaw \[rad\], as the base joints measure them; yaw unwrapped like the joint).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BaseReference {
+    /// `q_d` of base x, y, yaw.
+    pub position: [f64; 3],
+    /// `q̇_d` of base x, y, yaw (world frame) \[m/s, rad/s\].
+    pub velocity: [f64; 3],
+}
+
+impl BaseReference {
+    /// Index of the first non-finite value (positions 0-2, velocities 3-5), if any.
+    pub fn non_finite(&self) -> Option<usize> {
+        self.position.iter().chain(&self.velocity).position(|v| !v.is_finite())
+    }
+}
 
 /// Where a task acts in the control law.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

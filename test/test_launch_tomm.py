@@ -122,3 +122,31 @@ def test_the_real_robot_path_reads_a_setup_as_the_controller_does(scene, ament_p
 
     d = describe(scene)
     assert tuple(map(os.path.realpath, setup_files(d["setup"]))) == (d["urdf"], d["layout"])
+
+
+def test_sim_hardware_with_a_stamped_base_command(launch, rclpy_node):  # noqa: F811
+    """base_command_stamped:=true, as a ros2_control base controller needs it: the controller sends
+    geometry_msgs/TwistStamped in base_link, mujoco_sim (--base-command-stamped) drives the base
+    with it, and after Ctrl-C the last base command is a zero of the same type."""
+    from geometry_msgs.msg import TwistStamped
+    from nav_msgs.msg import Odometry
+
+    base, odom = [], []
+    rclpy_node.create_subscription(TwistStamped, "/base/cmd_vel", base.append, 1000)
+    rclpy_node.create_subscription(Odometry, "/base/odom", odom.append, 100)
+    # a scene whose base moves (tomm_movable_obstacles fixes it to the ground)
+    la = launch("skin_control", "tomm.launch.py", "hardware:=sim", "scene:=tactile_guidance",
+                "robot_state_publisher:=false", "base_command_stamped:=true")
+    moving = lambda: base and any(abs(v) > 1e-3 for v in (base[-1].twist.linear.x, base[-1].twist.linear.y, base[-1].twist.angular.z))  # noqa: E731
+    la.wait_for(rclpy_node, moving, "a moving TwistStamped base command")
+    position = lambda m: (m.pose.pose.position.x, m.pose.pose.position.y)  # noqa: E731
+    start = position(odom[-1])
+    spin_until(rclpy_node, lambda: max(abs(a - b) for a, b in zip(position(odom[-1]), start)) > 1e-3, 60.0,
+               "the simulated base moving on the stamped commands")
+    assert {m.header.frame_id for m in base} == {"base_link"}
+    assert all(m.header.stamp.sec > 0 or m.header.stamp.nanosec > 0 for m in base), "stamped (sim time)"
+    rc, alive = la.interrupt()
+    assert not alive and rc == 0 and "has died" not in la.output(), la.output()[-3000:]
+    zero = lambda m: (m.twist.linear.x, m.twist.linear.y, m.twist.angular.z) == (0.0, 0.0, 0.0)  # noqa: E731
+    spin_until(rclpy_node, lambda: zero(base[-1]), 10.0, "a zero TwistStamped last")
+    assert base[-1].header.frame_id == "base_link"

@@ -150,3 +150,31 @@ def test_sim_hardware_with_a_stamped_base_command(launch, rclpy_node):  # noqa: 
     zero = lambda m: (m.twist.linear.x, m.twist.linear.y, m.twist.angular.z) == (0.0, 0.0, 0.0)  # noqa: E731
     spin_until(rclpy_node, lambda: zero(base[-1]), 10.0, "a zero TwistStamped last")
     assert base[-1].header.frame_id == "base_link"
+
+
+@pytest.mark.parametrize("rsp, stamped", [("true", "false"), ("false", "true")])
+def test_the_controller_takes_robot_state_publishers_description_and_the_base_type(rsp, stamped, ament_prefix,
+                                                                                  monkeypatch):
+    """hardware:=real as data: task_controller takes the URDF from robot_description when
+    robot_state_publisher runs (mounted on the planar base: TOMM's starts at base_link there), else
+    from the setup's file; base_command_stamped reaches the controller and the watchdog."""
+    monkeypatch.setenv("AMENT_PREFIX_PATH", ament_prefix["AMENT_PREFIX_PATH"])
+    from launch.actions import DeclareLaunchArgument
+    from launch.launch_context import LaunchContext
+    from launch_ros.actions import Node
+    from launch_ros.utilities import evaluate_parameters
+
+    m = tomm_launch_module()
+    ctx = LaunchContext()
+    for a in m.generate_launch_description().entities:
+        if isinstance(a, DeclareLaunchArgument):
+            ctx.launch_configurations[a.name] = "".join(s.text for s in a.default_value)
+    ctx.launch_configurations.update(robot_state_publisher=rsp, base_command_stamped=stamped)
+    nodes = {str(a.node_executable): a for a in m.launch_setup(ctx) if isinstance(a, Node)}
+    params = {}
+    for p in evaluate_parameters(ctx, nodes["task_controller"]._Node__parameters):
+        params.update(p if isinstance(p, dict) else {})
+    assert params["use_robot_description"] == (rsp == "true") and params["mobile_base"] is True, params
+    assert params["base_command_stamped"] == (stamped == "true"), params
+    dog = texts(nodes["skin_watchdog"])
+    assert ("--base-stamped" in dog) == (stamped == "true"), dog

@@ -143,9 +143,11 @@ def test_twist_stamped_base_command_and_watchdog_zeros_of_the_same_type(spawn, r
     killed = time.time()
     spin_until(rclpy_node, lambda: got["base"][-1][0] > killed + 0.3, 30.0, "the watchdog's zeros")
     assert all(frame == "base_link" for _, frame, _ in robot.headers), {f for _, f, _ in robot.headers}
-    # fresh: stamped when sent (the sender's clock against the DDS source time)
+    # fresh: stamped at the period it was computed in, never after it was sent, and well within
+    # diff_drive_controller's default cmd_vel_timeout (0.5 s), past which a ros2_control base
+    # controller drops a command (the sender's clock against the DDS source time)
     lag = [source - stamp for source, _, stamp in robot.headers]
-    assert all(0 <= x < 0.1 for x in lag), (min(lag), max(lag))
+    assert all(0 <= x < 0.5 for x in lag), (min(lag), max(lag))
     zeros = [m for m in got["base"] if m[0] > killed + 0.05]
     assert zeros and all(v == 0.0 for m in zeros for v in m[1]), zeros[:3]
     print(f"{len(robot.headers)} stamped base commands, stamp to send {min(lag) * 1e3:.2f}-{max(lag) * 1e3:.2f} ms; "

@@ -189,4 +189,9 @@ def test_diagnostics_report_input_health_cycle_time_and_state(spawn, rclpy_node)
     assert level(diag.last("task_controller: input /base/odom")) == OK, "the other inputs stay ok"
     n = len(diag.arrays)
     spin_until(rclpy_node, lambda: len(diag.arrays) >= n + 2, 10.0, "two more reports")
-    print(f"/diagnostics: {len(diag.arrays)} reports; stale reported {took:.1f} s after the joint states stopped")
+    # once a second, as diagnostic_updater (an rcl timer keeps its schedule: the mean period is 1 s)
+    stamps = [a.header.stamp.sec + 1e-9 * a.header.stamp.nanosec for a in diag.arrays]
+    mean = (stamps[-1] - stamps[0]) / (len(stamps) - 1)
+    assert 0.9 < mean < 1.1, [round(b - a, 3) for a, b in zip(stamps, stamps[1:])]
+    print(f"/diagnostics: {len(diag.arrays)} reports, mean period {mean:.3f} s; stale reported {took:.1f} s "
+          "after the joint states stopped")

@@ -46,12 +46,13 @@ def setup_files(setup):
     while path and not {"urdf", "skin_layout"} <= set(found):
         data = yaml.safe_load(open(path))
         for key in ("urdf", "skin_layout"):
-            if key in data and key not in found:
-                found[key] = os.path.normpath(os.path.join(os.path.dirname(path), data[key]))
+            if key in data and key not in found:  # `urdf: null`: none (the controller's comes from a topic)
+                found[key] = data[key] and os.path.normpath(os.path.join(os.path.dirname(path), data[key]))
         path = os.path.join(os.path.dirname(path), data["base"]) if "base" in data else None
-    missing = {"urdf", "skin_layout"} - set(found)
+    missing = {k for k in ("urdf", "skin_layout") if not found.get(k)}
     if missing:
-        raise RuntimeError(f"setup:={setup}: names no {', '.join(sorted(missing))}")
+        raise RuntimeError(f"setup:={setup}: names no {', '.join(sorted(missing))} "
+                           "(robot_state_publisher and skin_aggregator need the files)")
     return found["urdf"], found["skin_layout"]
 
 

@@ -124,6 +124,30 @@ def test_the_real_robot_path_reads_a_setup_as_the_controller_does(scene, ament_p
     assert tuple(map(os.path.realpath, setup_files(d["setup"]))) == (d["urdf"], d["layout"])
 
 
+def test_a_setup_without_urdf(ament_prefix, monkeypatch, tmp_path):
+    """A robot setup whose controller takes robot_description (`urdf: null` over TOMM's): mujoco_sim
+    --describe names the scene's URDF, and hardware:=real (robot_state_publisher needs a file) says
+    the setup names none."""
+    import json
+    import subprocess
+    import sys
+
+    from conftest import binary
+
+    setup = tmp_path / "no_urdf.yaml"
+    setup.write_text(f"base: {TOP / 'config' / 'controller' / 'tomm.yaml'}\nurdf: null\n")
+    out = subprocess.run([binary("mujoco_sim"), "--describe", "--scene", "tactile_guidance", "--controller", setup],
+                         check=True, capture_output=True, text=True).stdout
+    assert json.loads(out)["urdf"] == str((TOP / "urdf" / "tomm.urdf").resolve())
+    monkeypatch.setenv("AMENT_PREFIX_PATH", ament_prefix["AMENT_PREFIX_PATH"])
+    pytest.importorskip("launch_ros", reason="needs the ROS 2 launch system (see conftest.ros2_or_skip)")
+    sys.path.insert(0, str(TOP / "launch"))
+    from skin_control_launch import setup_files
+
+    with pytest.raises(RuntimeError, match="names no urdf"):
+        setup_files(str(setup))
+
+
 def test_sim_hardware_with_a_stamped_base_command(launch, rclpy_node):  # noqa: F811
     """base_command_stamped:=true, as a ros2_control base controller needs it: the controller sends
     geometry_msgs/TwistStamped in base_link, mujoco_sim (--base-command-stamped) drives the base

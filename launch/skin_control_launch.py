@@ -46,12 +46,13 @@ def setup_files(setup):
     while path and not {"urdf", "skin_layout"} <= set(found):
         data = yaml.safe_load(open(path))
         for key in ("urdf", "skin_layout"):
-            if key in data and key not in found:
-                found[key] = os.path.normpath(os.path.join(os.path.dirname(path), data[key]))
+            if key in data and key not in found:  # `urdf: null`: none (the controller's comes from a topic)
+                found[key] = data[key] and os.path.normpath(os.path.join(os.path.dirname(path), data[key]))
         path = os.path.join(os.path.dirname(path), data["base"]) if "base" in data else None
-    missing = {"urdf", "skin_layout"} - set(found)
+    missing = {k for k in ("urdf", "skin_layout") if not found.get(k)}
     if missing:
-        raise RuntimeError(f"setup:={setup}: names no {', '.join(sorted(missing))}")
+        raise RuntimeError(f"setup:={setup}: names no {', '.join(sorted(missing))} "
+                           "(robot_state_publisher and skin_aggregator need the files)")
     return found["urdf"], found["skin_layout"]
 
 
@@ -74,13 +75,16 @@ def mounted_description(urdf_text):
     return ET.tostring(root, encoding="unicode")
 
 
-def graph_nodes(namespace, description, sim_time, autostart, trigger="timer", controller=None, watchdog=None):
+def graph_nodes(namespace, description, sim_time, autostart, trigger="timer", controller=None, watchdog=None,
+                stamped=False):
     """task_controller (with the parameters `controller` on top; activated at start when
-    `autostart` is "true"), skin_watchdog in timer mode (arguments `watchdog`, by
-    default the command topics the controller's heartbeat names), priority_supervisor,
-    skin_aggregator for `description` (a describe() result), robot_state_publisher and RViz when
-    the launch arguments `robot_state_publisher` and `rviz` say so; every node but RViz in
-    `namespace`."""
+    `autostart` is "true"; the base command as TwistStamped when `stamped`), skin_watchdog in
+    timer mode (arguments `watchdog`, by default the command topics the controller's heartbeat
+    names), priority_supervisor, skin_aggregator for `description` (a describe() result),
+    robot_state_publisher and RViz when the launch arguments `robot_state_publisher` and `rviz`
+    say so; every node but RViz in `namespace`. With robot_state_publisher the controller takes
+    the URDF from its robot_description topic (rooted at base_link on a robot with a base:
+    `mobile_base` puts the planar base joints back), else from the setup's file."""
     setup = description["setup"]
     time = {"use_sim_time": sim_time}
     urdf_text = open(description["urdf"]).read()
@@ -88,13 +92,15 @@ def graph_nodes(namespace, description, sim_time, autostart, trigger="timer", co
     # the simulation waits for the controller. Sim time: a wider timeout.
     guard = [] if trigger != "timer" else [
         Node(package=PKG, executable="skin_watchdog", name="skin_watchdog", namespace=namespace, output="screen",
-             arguments=watchdog or ["--learn-topics", "--timeout-s", "0.1"])]
+             arguments=(watchdog or ["--learn-topics", "--timeout-s", "0.1"]) + (["--base-stamped"] if stamped else []))]
     return guard + [
         Node(package=PKG, executable="task_controller", name="task_controller", namespace=namespace,
              output="screen",
              parameters=[share_file("config", "ros", "task_controller.yaml"), time,
                          {"setup_file": setup, "trigger": trigger, "use_scan": description["lidar"],
-                          "autostart": autostart == "true"},
+                          "autostart": autostart == "true", "base_command_stamped": stamped,
+                          "use_robot_description": LaunchConfiguration("robot_state_publisher"),
+                          "mobile_base": description["base"]},
                          controller or {}]),
         Node(package=PKG, executable="priority_supervisor", name="priority_supervisor", namespace=namespace,
              output="screen",

@@ -14,12 +14,14 @@ and ports (the driver opens four per arm: reverse, script sender, trajectory, sc
 by joint name), io_and_status_controller, speed_scaling_state_broadcaster and
 forward_velocity_controller, which task_controller commands on
 <ns>/forward_velocity_controller/commands (config/ros/ur_controllers.yaml). One
-robot_state_publisher for the whole robot (urdf/tomm.urdf from base_link down).
+robot_state_publisher for the whole robot (urdf/tomm.urdf from base_link down); task_controller takes
+the URDF from its robot_description (with robot_state_publisher:=false, from the setup's file).
 
 Base and skin drivers are site packages named by arguments (none started when empty). Topic
 contract, relative to `namespace`: the base driver publishes base/odom (nav_msgs/Odometry: pose
 in odom, twist in base_link), scan (sensor_msgs/LaserScan, frame `laser`) and TF odom -> base_link,
-and takes base/cmd_vel (geometry_msgs/Twist); the skin driver publishes skin/cells
+and takes base/cmd_vel (geometry_msgs/Twist; geometry_msgs/TwistStamped in frame base_link with
+base_command_stamped:=true, as ros2_control's mecanum/omni drive controllers take it); the skin driver publishes skin/cells
 (skin_msgs/SkinCellArray). Sensors may be best effort (REP 2003). A static world -> odom
 (tf2_ros) makes the goals' world frame the odometry frame, as the controller takes it
 (`world_tf:=false` when a localization publishes it).
@@ -99,7 +101,7 @@ def site_driver(kind, ns, arg):
 
 def launch_setup(context):
     arg = lambda name: LaunchConfiguration(name).perform(context)  # noqa: E731
-    ns, sim = arg("namespace"), arg("hardware") == "sim"
+    ns, sim, stamped = arg("namespace"), arg("hardware") == "sim", arg("base_command_stamped") == "true"
     if arg("hardware") not in ("real", "sim"):
         raise RuntimeError(f"hardware:={arg('hardware')}: must be real or sim")
     arm_list = arms(arg)
@@ -118,7 +120,8 @@ def launch_setup(context):
         robot = [Node(package=SIM_PKG, executable="mujoco_sim", name="mujoco_sim", namespace=ns, output="screen",
                       arguments=["--scene", description["scene"], "--realtime-factor", "1.0",
                                  *[x for n in namespaces for x in ("--arm-namespace", n)],
-                                 *[x for a in arm_list for x in ("--arm-prefix", a["tf_prefix"])]])]
+                                 *[x for a in arm_list for x in ("--arm-prefix", a["tf_prefix"])]]
+                      + (["--base-command-stamped"] if stamped else []))]
     else:
         robot = [ur_driver(a, ns, arg) for a in arm_list] + [site_driver("base", ns, arg), site_driver("skin", ns, arg)]
         if arg("world_tf") == "true":
@@ -130,7 +133,7 @@ def launch_setup(context):
     watchdog = [x for n in namespaces for x in ("--arm", f"{n}/forward_velocity_controller/commands=6")]
     autostart = arg("autostart") or ("true" if sim else "false")
     return robot + graph_nodes(ns, description, sim_time=sim, autostart=autostart, controller=commands,
-                               watchdog=watchdog + (["--timeout-s", "0.1"] if sim else []))
+                               watchdog=watchdog + (["--timeout-s", "0.1"] if sim else []), stamped=stamped)
 
 
 def generate_launch_description():
@@ -153,7 +156,10 @@ def generate_launch_description():
         ("skin_package", "", "skin driver package (empty: none started)"),
         ("skin_executable", "", "skin driver executable"),
         ("world_tf", "true", "hardware:=real: publish world -> odom (identity, tf2_ros)"),
-        ("robot_state_publisher", "true", "start robot_state_publisher"),
+        ("robot_state_publisher", "true", "start robot_state_publisher (task_controller then takes the URDF from "
+                                          "its robot_description; false: from the setup's file)"),
+        ("base_command_stamped", "false", "base/cmd_vel as geometry_msgs/TwistStamped (frame base_link), as "
+                                          "ros2_control's base controllers take it; false: geometry_msgs/Twist"),
         ("rviz", "false", "start RViz with config/skin.rviz"),
     ]
     for side, first in zip(SIDES, (50001, 50005)):

@@ -35,10 +35,11 @@ PARAMS = TOP / "config" / "ros" / "task_controller.yaml"
 
 class Robot:
     """Two arm drivers, the base and the skin at 100 Hz; each arm's joint states stamped now +
-    `offset[side]`, `None` silences a side, `nan` puts NaN into one of its positions."""
+    `offset[side]`, `None` silences a side, `nan` puts NaN into one of its positions. `stamped`:
+    the base takes geometry_msgs/TwistStamped (each one's frame and stamp kept in `headers`)."""
 
-    def __init__(self, node, cell_id):
-        from geometry_msgs.msg import PoseStamped, Twist
+    def __init__(self, node, cell_id, stamped=False):
+        from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
         from nav_msgs.msg import Odometry
         from sensor_msgs.msg import JointState, LaserScan
         from skin_msgs.msg import ControllerState, SkinCellArray
@@ -58,7 +59,11 @@ class Robot:
         for side in ("left", "right"):
             node.create_subscription(Float64MultiArray, f"/{side}_arm/forward_velocity_controller/commands",
                                      lambda m, info, s=side: self.on_arm(s, m, info), DEEP)
-        node.create_subscription(Twist, "/base/cmd_vel", self.on_twist, DEEP)
+        self.headers = []  # stamped: (source time, frame_id, header stamp) per base command
+        if stamped:
+            node.create_subscription(TwistStamped, "/base/cmd_vel", self.on_twist_stamped, DEEP)
+        else:
+            node.create_subscription(Twist, "/base/cmd_vel", self.on_twist, DEEP)
         node.create_subscription(ControllerState, "/controller/state", self.got["state"].append, DEEP)
         self.pub = {"js": node.create_publisher(JointState, "/joint_states", DEEP),
                     "odom": node.create_publisher(Odometry, "/base/odom", DEEP),
@@ -75,6 +80,11 @@ class Robot:
     def on_twist(self, msg, info):
         self.twist = [msg.linear.x, msg.linear.y, msg.angular.z]
         self.got["base"].append((info["source_timestamp"] * 1e-9, list(self.twist)))
+
+    def on_twist_stamped(self, msg, info):
+        stamp = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+        self.headers.append((info["source_timestamp"] * 1e-9, msg.header.frame_id, stamp))
+        self.on_twist(msg.twist, info)
 
     def send_goal(self, x=2.0, y=-0.3, z=1.0):
         """A goal out of reach of the arm alone: the right arm and the base move."""

@@ -18,7 +18,7 @@ import yaml
 from conftest import TOP, binary, cell_array, ros2_or_skip, spin_until
 
 # The graph's topics that are global by ROS convention (rcl's time source, tf2, logging).
-GLOBAL_TOPICS = {"/clock", "/tf", "/tf_static", "/rosout", "/parameter_events"}
+GLOBAL_TOPICS = {"/clock", "/tf", "/tf_static", "/rosout", "/parameter_events", "/diagnostics"}
 
 
 class Launch:

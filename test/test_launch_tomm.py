@@ -122,3 +122,83 @@ def test_the_real_robot_path_reads_a_setup_as_the_controller_does(scene, ament_p
 
     d = describe(scene)
     assert tuple(map(os.path.realpath, setup_files(d["setup"]))) == (d["urdf"], d["layout"])
+
+
+def test_a_setup_without_urdf(ament_prefix, monkeypatch, tmp_path):
+    """A robot setup whose controller takes robot_description (`urdf: null` over TOMM's): mujoco_sim
+    --describe names the scene's URDF, and hardware:=real (robot_state_publisher needs a file) says
+    the setup names none."""
+    import json
+    import subprocess
+    import sys
+
+    from conftest import binary
+
+    setup = tmp_path / "no_urdf.yaml"
+    setup.write_text(f"base: {TOP / 'config' / 'controller' / 'tomm.yaml'}\nurdf: null\n")
+    out = subprocess.run([binary("mujoco_sim"), "--describe", "--scene", "tactile_guidance", "--controller", setup],
+                         check=True, capture_output=True, text=True).stdout
+    assert json.loads(out)["urdf"] == str((TOP / "urdf" / "tomm.urdf").resolve())
+    monkeypatch.setenv("AMENT_PREFIX_PATH", ament_prefix["AMENT_PREFIX_PATH"])
+    pytest.importorskip("launch_ros", reason="needs the ROS 2 launch system (see conftest.ros2_or_skip)")
+    sys.path.insert(0, str(TOP / "launch"))
+    from skin_control_launch import setup_files
+
+    with pytest.raises(RuntimeError, match="names no urdf"):
+        setup_files(str(setup))
+
+
+def test_sim_hardware_with_a_stamped_base_command(launch, rclpy_node):  # noqa: F811
+    """base_command_stamped:=true, as a ros2_control base controller needs it: the controller sends
+    geometry_msgs/TwistStamped in base_link, mujoco_sim (--base-command-stamped) drives the base
+    with it, and after Ctrl-C the last base command is a zero of the same type."""
+    from geometry_msgs.msg import TwistStamped
+    from nav_msgs.msg import Odometry
+
+    base, odom = [], []
+    rclpy_node.create_subscription(TwistStamped, "/base/cmd_vel", base.append, 1000)
+    rclpy_node.create_subscription(Odometry, "/base/odom", odom.append, 100)
+    # a scene whose base moves (tomm_movable_obstacles fixes it to the ground)
+    la = launch("skin_control", "tomm.launch.py", "hardware:=sim", "scene:=tactile_guidance",
+                "robot_state_publisher:=false", "base_command_stamped:=true")
+    moving = lambda: base and any(abs(v) > 1e-3 for v in (base[-1].twist.linear.x, base[-1].twist.linear.y, base[-1].twist.angular.z))  # noqa: E731
+    la.wait_for(rclpy_node, moving, "a moving TwistStamped base command")
+    position = lambda m: (m.pose.pose.position.x, m.pose.pose.position.y)  # noqa: E731
+    start = position(odom[-1])
+    spin_until(rclpy_node, lambda: max(abs(a - b) for a, b in zip(position(odom[-1]), start)) > 1e-3, 60.0,
+               "the simulated base moving on the stamped commands")
+    assert {m.header.frame_id for m in base} == {"base_link"}
+    assert all(m.header.stamp.sec > 0 or m.header.stamp.nanosec > 0 for m in base), "stamped (sim time)"
+    rc, alive = la.interrupt()
+    assert not alive and rc == 0 and "has died" not in la.output(), la.output()[-3000:]
+    zero = lambda m: (m.twist.linear.x, m.twist.linear.y, m.twist.angular.z) == (0.0, 0.0, 0.0)  # noqa: E731
+    spin_until(rclpy_node, lambda: zero(base[-1]), 10.0, "a zero TwistStamped last")
+    assert base[-1].header.frame_id == "base_link"
+
+
+@pytest.mark.parametrize("rsp, stamped", [("true", "false"), ("false", "true")])
+def test_the_controller_takes_robot_state_publishers_description_and_the_base_type(rsp, stamped, ament_prefix,
+                                                                                  monkeypatch):
+    """hardware:=real as data: task_controller takes the URDF from robot_description when
+    robot_state_publisher runs (mounted on the planar base: TOMM's starts at base_link there), else
+    from the setup's file; base_command_stamped reaches the controller and the watchdog."""
+    monkeypatch.setenv("AMENT_PREFIX_PATH", ament_prefix["AMENT_PREFIX_PATH"])
+    from launch.actions import DeclareLaunchArgument
+    from launch.launch_context import LaunchContext
+    from launch_ros.actions import Node
+    from launch_ros.utilities import evaluate_parameters
+
+    m = tomm_launch_module()
+    ctx = LaunchContext()
+    for a in m.generate_launch_description().entities:
+        if isinstance(a, DeclareLaunchArgument):
+            ctx.launch_configurations[a.name] = "".join(s.text for s in a.default_value)
+    ctx.launch_configurations.update(robot_state_publisher=rsp, base_command_stamped=stamped)
+    nodes = {str(a.node_executable): a for a in m.launch_setup(ctx) if isinstance(a, Node)}
+    params = {}
+    for p in evaluate_parameters(ctx, nodes["task_controller"]._Node__parameters):
+        params.update(p if isinstance(p, dict) else {})
+    assert params["use_robot_description"] == (rsp == "true") and params["mobile_base"] is True, params
+    assert params["base_command_stamped"] == (stamped == "true"), params
+    dog = texts(nodes["skin_watchdog"])
+    assert ("--base-stamped" in dog) == (stamped == "true"), dog

@@ -112,7 +112,8 @@ def test_namespace_and_remapping_apply_to_every_topic(spawn, rclpy_node):
     assert ("task_controller", "/arm7") in rclpy_node.get_node_names_and_namespaces()
     topics = [t for get in (rclpy_node.get_publisher_names_and_types_by_node, rclpy_node.get_subscriber_names_and_types_by_node)
               for t, _ in get("task_controller", "/arm7")]
-    global_topics = {"/rosout", "/parameter_events", "/clock", "/driver/cells"}
+    # global by ROS convention (/diagnostics: as diagnostic_updater publishes it), and the remapped one
+    global_topics = {"/rosout", "/parameter_events", "/clock", "/diagnostics", "/driver/cells"}
     assert "/driver/cells" in topics and "/arm7/joint_states" in topics, topics
     assert not [t for t in topics if not t.startswith("/arm7/") and t not in global_topics], topics
     services = [s for s, _ in rclpy_node.get_service_names_and_types_by_node("task_controller", "/arm7")]

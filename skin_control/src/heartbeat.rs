@@ -4,12 +4,37 @@
 //!
 //! `header.frame_id` identifies the sender: `<start ns> <pid>@<host> <topic>,<topic>,...` (its
 //! start time on the system clock, its process, its command topics: `<topic>=<joints>` for an
-//! arm's `Float64MultiArray`, `<topic>` for the base's `Twist`); `header.stamp` is the
-//! controller's clock at the period.
+//! arm's `Float64MultiArray`, `<topic>` for the base's `Twist`, `<topic>=twist_stamped` for a
+//! base's `TwistStamped`); `header.stamp` is the controller's clock at the period.
 use std::fmt;
 
 /// The heartbeat topic.
 pub const TOPIC: &str = "/controller/heartbeat";
+
+/// What a command topic carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CommandType {
+    /// An arm's joint velocities (`std_msgs/Float64MultiArray`) of this many joints.
+    Arm(usize),
+    /// The base's twist (`geometry_msgs/Twist`).
+    Twist,
+    /// The base's twist with a header (`geometry_msgs/TwistStamped`, frame `base_link`).
+    TwistStamped,
+}
+
+/// The heartbeat's suffix of a [`CommandType::TwistStamped`] topic.
+const STAMPED: &str = "twist_stamped";
+
+impl CommandType {
+    /// `topic` with this type, as a heartbeat names it.
+    pub fn describe(self, topic: &str) -> String {
+        match self {
+            CommandType::Arm(n) => format!("{topic}={n}"),
+            CommandType::Twist => topic.to_string(),
+            CommandType::TwistStamped => format!("{topic}={STAMPED}"),
+        }
+    }
+}
 
 /// Who sends a heartbeat.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -18,7 +43,7 @@ pub struct Commander {
     pub start_ns: u64,
     /// `<pid>@<host>`.
     pub process: String,
-    /// The command topics it publishes (`<topic>=<joints>` for an arm, `<topic>` for the base).
+    /// The command topics it publishes ([`CommandType::describe`]).
     pub topics: Vec<String>,
 }
 
@@ -41,11 +66,12 @@ impl Commander {
         parts.next().is_none().then_some(Commander { start_ns, process, topics })
     }
 
-    /// The command topics with their joint counts (None: the base's twist).
-    pub fn topics(&self) -> impl Iterator<Item = (&str, Option<usize>)> + '_ {
+    /// The command topics with what they carry (None: a suffix this version does not know).
+    pub fn topics(&self) -> impl Iterator<Item = (&str, Option<CommandType>)> + '_ {
         self.topics.iter().map(|t| match t.split_once('=') {
-            Some((name, n)) => (name, n.parse().ok()),
-            None => (t.as_str(), None),
+            Some((name, STAMPED)) => (name, Some(CommandType::TwistStamped)),
+            Some((name, n)) => (name, n.parse().ok().map(CommandType::Arm)),
+            None => (t.as_str(), Some(CommandType::Twist)),
         })
     }
 
@@ -79,7 +105,17 @@ mod tests {
         let topics = |t: &[&str]| t.iter().map(|s| s.to_string()).collect::<Vec<_>>();
         let a = Commander { start_ns: 10, process: "1@h".into(), topics: topics(&["/l=6", "/base/cmd_vel"]) };
         assert_eq!(a.to_string(), "10 1@h /l=6,/base/cmd_vel");
-        assert_eq!(a.topics().collect::<Vec<_>>(), [("/l", Some(6)), ("/base/cmd_vel", None)]);
+        assert_eq!(
+            a.topics().collect::<Vec<_>>(),
+            [("/l", Some(CommandType::Arm(6))), ("/base/cmd_vel", Some(CommandType::Twist))]
+        );
+        let described = [CommandType::Arm(7), CommandType::Twist, CommandType::TwistStamped].map(|c| c.describe("/t"));
+        assert_eq!(described, ["/t=7", "/t", "/t=twist_stamped"]);
+        let s = Commander { topics: described.to_vec(), ..a.clone() };
+        let kinds: Vec<_> = s.topics().map(|(_, k)| k).collect();
+        assert_eq!(kinds, [Some(CommandType::Arm(7)), Some(CommandType::Twist), Some(CommandType::TwistStamped)]);
+        let odd = Commander { topics: topics(&["/t=wrench"]), ..a.clone() };
+        assert_eq!(odd.topics().collect::<Vec<_>>(), [("/t", None)], "an unknown type is not guessed");
         assert_eq!(Commander::parse(&a.to_string()), Some(a.clone()));
         for bad in ["", "x 1@h /l", "10 1@h", "10 1@h /l extra"] {
             assert_eq!(Commander::parse(bad), None, "{bad}");

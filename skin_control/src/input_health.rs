@@ -108,6 +108,14 @@ impl IssueTable {
         self.names.iter().position(|n| n == name).map(|k| self.counts[k])
     }
 
+    /// The counters of `topic`: `(kind, count)` in registration order.
+    pub fn of_topic<'a>(&'a self, topic: &'a str) -> impl Iterator<Item = (&'a str, u64)> + 'a {
+        self.names.iter().zip(&self.counts).filter_map(move |(name, &count)| {
+            let kind = name.strip_prefix(topic)?.strip_prefix(": ")?;
+            Some((kind, count))
+        })
+    }
+
     /// Sum of all counters.
     pub fn total(&self) -> u64 {
         self.counts.iter().sum()
@@ -188,6 +196,8 @@ mod tests {
         assert!(t.count(b));
         assert_eq!((t.get(a), t.get(a + 1), t.total()), (0, 2, 3));
         assert_eq!(t.by_name("/a: y"), Some(2));
+        assert_eq!(t.of_topic("/a").collect::<Vec<_>>(), [("x", 0), ("y", 2)]);
+        assert_eq!(t.of_topic("/").count(), 0, "a whole topic name only");
         assert_eq!(t.to_string(), "/a: y: 2; /b: z: 1");
         let mut msg = ControllerState::default();
         t.write(&mut msg);

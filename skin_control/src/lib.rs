@@ -8,6 +8,7 @@
 
 pub mod aggregator;
 pub mod convert;
+pub mod diagnostics;
 pub mod heartbeat;
 pub mod input_health;
 pub mod lifecycle;
@@ -15,6 +16,7 @@ pub mod markers;
 pub mod nodes;
 pub mod paths;
 pub mod qos;
+pub mod robot_description;
 pub mod ros_params;
 pub mod rosbag;
 pub mod shutdown;

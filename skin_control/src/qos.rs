@@ -39,6 +39,11 @@ pub fn latched() -> QosProfile {
     QosProfile::default().reliable().keep_last(1).transient_local()
 }
 
+/// `/diagnostics`: reliable, volatile, keep last 1, as ROS 2's diagnostic_updater publishes it.
+pub fn diagnostics() -> QosProfile {
+    QosProfile::default().reliable().volatile().keep_last(1)
+}
+
 /// Services: the rmw default (reliable, volatile, keep last 10).
 pub fn services() -> QosProfile {
     QosProfile::default()

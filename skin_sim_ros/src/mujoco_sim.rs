@@ -28,7 +28,7 @@ use anyhow::{Context as _, Result};
 use futures::executor::LocalSpawner;
 use futures::task::LocalSpawnExt;
 use futures::StreamExt;
-use r2r::geometry_msgs::msg::{PoseStamped, Twist};
+use r2r::geometry_msgs::msg::{PoseStamped, Twist, TwistStamped};
 use r2r::nav_msgs::msg::Odometry;
 use r2r::rosgraph_msgs::msg::Clock;
 use r2r::sensor_msgs::msg::{JointState, LaserScan};
@@ -79,6 +79,10 @@ pub struct Options {
     /// Joint-name prefix per arm, pairs with --arm-namespace (default: left_ right_, else "").
     #[arg(long = "arm-prefix", value_name = "PREFIX")]
     pub arm_prefixes: Vec<String>,
+    /// The base command as geometry_msgs/TwistStamped (task_controller's base_command_stamped,
+    /// ros2_control's base controllers); default: geometry_msgs/Twist.
+    #[arg(long)]
+    pub base_command_stamped: bool,
     /// Write the applied commands per period (JSON) here at the end.
     #[arg(long, value_name = "FILE")]
     pub record: Option<PathBuf>,
@@ -113,6 +117,7 @@ pub fn describe(scene: &str, setup: Option<PathBuf>) -> Result<serde_json::Value
     let (setup, _) = skin_core::controller::ControllerSetup::load(&target.controller)
         .with_context(|| target.controller.display().to_string())?;
     let dir = target.controller.parent().unwrap_or(std::path::Path::new("."));
+    let scene_dir = target.scene.parent().unwrap_or(std::path::Path::new("."));
     let absolute = |p: &std::path::Path| {
         std::fs::canonicalize(p).or_else(|_| std::path::absolute(p)).unwrap_or_else(|_| p.to_path_buf())
     };
@@ -120,7 +125,8 @@ pub fn describe(scene: &str, setup: Option<PathBuf>) -> Result<serde_json::Value
     Ok(serde_json::json!({
         "scene": absolute(&target.scene),
         "setup": absolute(&target.controller),
-        "urdf": absolute(&dir.join(&setup.urdf)),
+        // a setup without a URDF (its node takes robot_description): the scene's robot
+        "urdf": absolute(&setup.urdf.map_or_else(|| scene_dir.join(&loaded.spec.robot.urdf), |u| dir.join(u))),
         "layout": absolute(&dir.join(&setup.skin_layout)),
         "lidar": loaded.spec.lidar.is_some(),
         "base": skin_control::convert::robot::base_joints(&loaded.model).is_some(),
@@ -520,7 +526,15 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, mut options: Options)
             }
         })?;
     }
-    if bridge.has_base() {
+    if bridge.has_base() && options.base_command_stamped {
+        let mut sub = node.subscribe::<TwistStamped>(local(CMD_VEL), qos::stream())?;
+        let inbox = inbox.clone();
+        spawner.spawn_local(async move {
+            while let Some(m) = sub.next().await {
+                inbox.borrow_mut().twist = Some(m.twist);
+            }
+        })?;
+    } else if bridge.has_base() {
         let mut sub = node.subscribe::<Twist>(local(CMD_VEL), qos::stream())?;
         let inbox = inbox.clone();
         spawner.spawn_local(async move {

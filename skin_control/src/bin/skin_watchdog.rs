@@ -6,10 +6,12 @@ use std::time::{Duration, Instant};
 use anyhow::{Context as _, Result};
 use clap::Parser;
 use futures::{FutureExt as _, StreamExt as _};
-use r2r::geometry_msgs::msg::Twist;
+use r2r::geometry_msgs::msg::{Twist, TwistStamped};
 use r2r::std_msgs::msg::{Float64MultiArray, Header};
-use skin_control::nodes::local;
+use skin_control::heartbeat::CommandType;
 use skin_control::nodes::topics::{CMD_VEL, WATCHDOG};
+use skin_control::nodes::{local, ros_now};
+use skin_control::tf::BASE_FRAME;
 use skin_control::watchdog::{Verdict, Watchdog};
 use skin_control::{heartbeat, nodes, qos, shutdown};
 
@@ -36,6 +38,10 @@ struct Args {
     /// The base's twist topic (geometry_msgs/Twist; relative: under the node's namespace).
     #[arg(long, value_name = "TOPIC", default_value = local(CMD_VEL))]
     base: String,
+    /// The base's topic carries geometry_msgs/TwistStamped (task_controller's
+    /// base_command_stamped; the zeros in frame base_link, stamped with the node's clock).
+    #[arg(long)]
+    base_stamped: bool,
     /// No base topic (a fixed arm).
     #[arg(long)]
     no_base: bool,
@@ -54,22 +60,34 @@ struct Args {
     hold_period_s: f64,
 }
 
+/// A base's command publisher, of the type the base takes.
+enum BasePublisher {
+    Twist(r2r::Publisher<Twist>),
+    Stamped(r2r::Publisher<TwistStamped>),
+}
+
 /// The command topics and their zero messages.
 #[derive(Default)]
 struct Outputs {
     arms: Vec<(String, r2r::Publisher<Float64MultiArray>, Float64MultiArray)>,
-    bases: Vec<(String, r2r::Publisher<Twist>)>,
+    bases: Vec<(String, BasePublisher)>,
 }
 
 impl Outputs {
-    /// An arm's topic with its joint count, or (None) a base's twist topic.
-    fn add(&mut self, node: &mut r2r::Node, topic: &str, joints: Option<usize>) -> r2r::Result<()> {
-        match joints {
-            Some(n) => {
+    /// A command topic of type `kind`.
+    fn add(&mut self, node: &mut r2r::Node, topic: &str, kind: CommandType) -> r2r::Result<()> {
+        let name = topic.to_string();
+        match kind {
+            CommandType::Arm(n) => {
                 let msg = Float64MultiArray { data: vec![0.0; n], ..Default::default() };
-                self.arms.push((topic.to_string(), node.create_publisher(topic, qos::stream())?, msg));
+                self.arms.push((name, node.create_publisher(topic, qos::stream())?, msg));
             }
-            None => self.bases.push((topic.to_string(), node.create_publisher(topic, qos::stream())?)),
+            CommandType::Twist => {
+                self.bases.push((name, BasePublisher::Twist(node.create_publisher(topic, qos::stream())?)))
+            }
+            CommandType::TwistStamped => {
+                self.bases.push((name, BasePublisher::Stamped(node.create_publisher(topic, qos::stream())?)))
+            }
         }
         Ok(())
     }
@@ -78,12 +96,23 @@ impl Outputs {
         self.arms.iter().map(|a| a.0.clone()).chain(self.bases.iter().map(|b| b.0.clone())).collect()
     }
 
-    /// Zeros on every topic.
-    fn zeros(&self) -> r2r::Result<()> {
+    /// Zeros on every topic; a stamped twist carries `now_s` (the node's clock) and frame
+    /// base_link.
+    fn zeros(&self, now_s: f64) -> r2r::Result<()> {
         for (_, p, m) in &self.arms {
             p.publish(m)?;
         }
-        self.bases.iter().try_for_each(|(_, p)| p.publish(&Twist::default()))
+        for (_, base) in &self.bases {
+            match base {
+                BasePublisher::Twist(p) => p.publish(&Twist::default())?,
+                BasePublisher::Stamped(p) => {
+                    let stamp = skin_control::convert::robot::time_msg(now_s);
+                    let header = Header { stamp, frame_id: BASE_FRAME.into() };
+                    p.publish(&TwistStamped { header, twist: Twist::default() })?
+                }
+            }
+        }
+        Ok(())
     }
 }
 
@@ -115,10 +144,11 @@ fn main() -> Result<()> {
     let logger = node.logger().to_string();
     let mut out = Outputs::default();
     for (t, n) in &args.arms {
-        out.add(&mut node, t, Some(*n))?;
+        out.add(&mut node, t, CommandType::Arm(*n))?;
     }
     if !args.no_base && !args.learn_topics {
-        out.add(&mut node, &args.base, None)?;
+        let kind = if args.base_stamped { CommandType::TwistStamped } else { CommandType::Twist };
+        out.add(&mut node, &args.base, kind)?;
     }
     let trips = node.create_publisher::<Header>(local(WATCHDOG), qos::stream())?;
     let mut beats = node.subscribe::<Header>(local(heartbeat::TOPIC), qos::stream())?;
@@ -136,6 +166,8 @@ fn main() -> Result<()> {
         Instant::now(),
     );
     let mut last_sender = String::from("none yet");
+    // topics of a type this version does not know, warned about once
+    let mut unknown: Vec<String> = Vec::new();
     let mut failed = false;
     while !shutdown::requested() {
         let now = Instant::now();
@@ -145,10 +177,20 @@ fn main() -> Result<()> {
                 r2r::log_info!(&logger, "heartbeat from {}: zeros stop", beat.frame_id);
             }
             if let Some(sender) = heartbeat::Commander::parse(&beat.frame_id).filter(|_| args.learn_topics) {
-                for (topic, joints) in sender.topics() {
-                    if !out.topics().iter().any(|t| t == topic) {
-                        out.add(&mut node, topic, joints)?;
-                        r2r::log_info!(&logger, "zeros on {topic} too (named by the heartbeat)");
+                for (topic, kind) in sender.topics() {
+                    if out.topics().iter().any(|t| t == topic) {
+                        continue;
+                    }
+                    match kind {
+                        Some(kind) => {
+                            out.add(&mut node, topic, kind)?;
+                            r2r::log_info!(&logger, "zeros on {topic} too (named by the heartbeat, {kind:?})");
+                        }
+                        None if !unknown.iter().any(|t| t == topic) => {
+                            r2r::log_warn!(&logger, "heartbeat names {topic} of an unknown type: not zeroed");
+                            unknown.push(topic.to_string());
+                        }
+                        None => {}
                     }
                 }
             }
@@ -158,7 +200,7 @@ fn main() -> Result<()> {
         if verdict == Verdict::Quiet {
             continue;
         }
-        let mut sent = out.zeros();
+        let mut sent = out.zeros(ros_now(&node));
         if verdict == Verdict::Trip {
             let why = format!(
                 "no heartbeat for {} s from {last_sender}: zero commands on {}",

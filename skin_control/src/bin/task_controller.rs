@@ -33,7 +33,15 @@ fn main() -> Result<()> {
     let ctx = r2r::Context::create()?;
     let mut node = r2r::Node::create(ctx, task_controller::NODE, "")?;
     let mut pool = LocalPool::new();
-    let handle = task_controller::start(&mut node, &pool.spawner(), args.options)?;
+    let handle = match task_controller::start(&mut node, &pool.spawner(), args.options) {
+        Ok(handle) => handle,
+        // SIGINT/SIGTERM while waiting for the URDF on robot_description: nothing was commanded
+        Err(e) if shutdown::requested() => {
+            r2r::log_info!(node.logger(), "{e:#}");
+            return Ok(());
+        }
+        Err(e) => return Err(e),
+    };
     args.wait.wait(task_controller::NODE, &handle.output_topics(), |t| handle.subscription_count(t))?;
     nodes::spin(&mut node, &mut pool, || {
         handle.poll();

@@ -211,6 +211,19 @@ impl StateBuffer {
             .try_fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| t.map(|t| (lo.min(t), hi.max(t))))
     }
 
+    /// The joint (not a base joint) with the oldest value and its time \[s\] (None: one has none).
+    pub fn oldest_joint(&self) -> Option<(&str, f64)> {
+        let arm = self.time.iter().enumerate().filter(|(j, _)| !self.base.is_some_and(|b| b.contains(j)));
+        let mut oldest: Option<(usize, f64)> = None;
+        for (j, t) in arm {
+            let t = (*t)?;
+            if oldest.is_none_or(|(_, o)| t < o) {
+                oldest = Some((j, t));
+            }
+        }
+        oldest.map(|(j, t)| (self.names[j].as_str(), t))
+    }
+
     /// Stamp \[s\] of the last odometry message that was used.
     pub fn odom_time(&self) -> Option<f64> {
         self.base.and_then(|b| self.time[b[0]])
@@ -587,6 +600,8 @@ mod tests {
         nan.velocity[2] = f64::NAN;
         assert_eq!(buf.update_joints(&nan, f64::INFINITY, |_| {}), 5, "the NaN joint is not refreshed");
         assert_eq!(buf.joint_times().unwrap(), (9.99, 10.5));
+        let right: Vec<&String> = model.joint_names().iter().filter(|n| n.starts_with("right_")).collect();
+        assert_eq!(buf.oldest_joint(), Some((right[2].as_str(), 9.99)), "the joint the NaN kept old");
         // the clock went back below the joints' times: an older stamp is written again
         assert_eq!(buf.update_joints(&arm("left_", 5.0, 0.6), 9.0, |_| {}), 6);
         assert_eq!(buf.q()[le], 0.6);

@@ -9,13 +9,15 @@ use anyhow::{Context as _, Result};
 use futures::executor::LocalSpawner;
 use futures::task::LocalSpawnExt;
 use futures::{Stream, StreamExt};
-use r2r::geometry_msgs::msg::{PoseStamped, Twist};
+use r2r::diagnostic_msgs::msg::DiagnosticArray;
+use r2r::geometry_msgs::msg::{PoseStamped, Twist, TwistStamped};
 use r2r::nav_msgs::msg::Odometry;
 use r2r::sensor_msgs::msg::{JointState, LaserScan};
 use r2r::skin_msgs::msg::{Arrangement, ControllerState};
-use r2r::std_msgs::msg::{Float64, Float64MultiArray, Header};
+use r2r::std_msgs::msg::{Float64, Float64MultiArray, Header, String as StringMsg};
 use r2r::{ParameterValue, RosParams};
-use skin_core::controller::ControllerConfig;
+use skin_core::controller::{ControllerConfig, ControllerSetup};
+use skin_core::model::RobotModel;
 use skin_core::param_file::declare::{Declared, ParamSpec};
 use skin_core::skin::params::SkinParams;
 use skin_core::tasks::params::TaskParams;
@@ -23,13 +25,16 @@ use skin_core::tasks::params::TaskParams;
 use super::topics::*;
 use super::{file_setting, local, resolve, resolved, ros_now, OnceLog, Timing};
 use crate::convert::robot::time_msg;
-use crate::heartbeat::{self, Commander};
+use crate::diagnostics::{self, level, Diagnostics, LoopReport};
+use crate::heartbeat::{self, CommandType, Commander};
 use crate::lifecycle::{self, Lifecycle};
 use crate::qos;
+use crate::robot_description::{self, UrdfSource};
 use crate::ros_params::StructParams;
 use crate::task_controller::{
     Freshness, Idle, InputError, Outputs, TaskController, TaskControllerParams, Trigger, DESCRIPTIONS, START_ONLY,
 };
+use crate::tf::BASE_FRAME;
 use r2r::lifecycle_msgs::msg::{
     State as StateMsg, Transition, Transition as TransitionMsg, TransitionDescription, TransitionEvent,
 };
@@ -46,20 +51,51 @@ pub struct Options {
     pub setup: Option<String>,
 }
 
+/// The base command's publisher: `Twist`, or `TwistStamped` (`base_command_stamped`).
+enum BasePublisher {
+    Twist(r2r::Publisher<Twist>),
+    Stamped(r2r::Publisher<TwistStamped>),
+}
+
+impl BasePublisher {
+    fn publish(&self, twist: &Twist, stamp: &r2r::builtin_interfaces::msg::Time) -> r2r::Result<()> {
+        match self {
+            BasePublisher::Twist(p) => p.publish(twist),
+            BasePublisher::Stamped(p) => p.publish(&TwistStamped {
+                header: Header { stamp: stamp.clone(), frame_id: BASE_FRAME.into() },
+                twist: twist.clone(),
+            }),
+        }
+    }
+
+    fn subscription_count(&self) -> r2r::Result<usize> {
+        match self {
+            BasePublisher::Twist(p) => p.get_inter_process_subscription_count(),
+            BasePublisher::Stamped(p) => p.get_inter_process_subscription_count(),
+        }
+    }
+}
+
 struct Publishers {
     arms: Vec<r2r::Publisher<Float64MultiArray>>,
-    base: Option<r2r::Publisher<Twist>>,
+    base: Option<BasePublisher>,
     state: r2r::Publisher<ControllerState>,
 }
 
 impl Publishers {
-    /// Sends `out`; the first failure is returned with the topic.
-    fn send(&self, out: &Outputs, topics: &[String]) -> std::result::Result<(), String> {
+    /// Sends `out` (a stamped base command stamped `stamp`); the first failure is returned with
+    /// the topic.
+    fn send(
+        &self,
+        out: &Outputs,
+        topics: &[String],
+        stamp: &r2r::builtin_interfaces::msg::Time,
+    ) -> std::result::Result<(), String> {
         for ((p, m), t) in self.arms.iter().zip(out.arms).zip(topics) {
             p.publish(m).map_err(|e| format!("{t}: {e}"))?;
         }
         if let (Some(p), Some(m)) = (&self.base, out.base) {
-            p.publish(m).map_err(|e| format!("{CMD_VEL}: {e}"))?;
+            p.publish(m, stamp).map_err(|e| format!("{CMD_VEL}: {e}"))?;
         }
         if let Some(m) = out.state {
             self.state.publish(m).map_err(|e| format!("{CONTROLLER_STATE}: {e}"))?;
@@ -120,6 +156,12 @@ struct Shared {
     publish_failed: bool,
     stale: bool,
     timing: Timing,
+    /// `/diagnostics`: the reports, the cycle times since the last one, the overrun counts.
+    diagnostics: Diagnostics,
+    diagnostics_pub: r2r::Publisher<DiagnosticArray>,
+    period_timing: Timing,
+    overruns: u64,
+    late_periods: u64,
 }
 
 impl Shared {
@@ -130,9 +172,10 @@ impl Shared {
             return;
         }
         let now = self.now();
+        let stamp = time_msg(now);
         let out = which(&mut self.tc);
-        let sent = self.pubs.send(&out, &self.topics);
-        self.beat.stamp = time_msg(now);
+        let sent = self.pubs.send(&out, &self.topics, &stamp);
+        self.beat.stamp = stamp;
         let sent =
             sent.and_then(|()| self.heartbeat.publish(&self.beat).map_err(|e| format!("{}: {e}", heartbeat::TOPIC)));
         if let Err(e) = sent {
@@ -156,6 +199,7 @@ impl Shared {
         if self.command == Command::Active
             && self.last_sent_s.is_some_and(|last| now - last > WATCHDOG_PERIODS * period)
         {
+            self.late_periods += 1;
             self.beat(now);
             return Period::Silent;
         }
@@ -259,7 +303,12 @@ impl Shared {
     fn run_cycle(&mut self, t_s: f64, stamp: &r2r::builtin_interfaces::msg::Time) {
         let start = Instant::now();
         self.publish(|tc| tc.cycle(t_s, stamp));
-        self.timing.add(start.elapsed());
+        let took = start.elapsed();
+        self.timing.add(took);
+        self.period_timing.add(took);
+        if took.as_secs_f64() > 1.0 / self.tc.params().control_rate_hz {
+            self.overruns += 1;
+        }
         if let Some(f) = self.tc.last_fault() {
             if self.fault_log.first(0) {
                 r2r::log_warn!(
@@ -273,6 +322,60 @@ impl Shared {
     /// The node's clock now \[s\].
     fn now(&self) -> f64 {
         self.clock.lock().unwrap().get_now().map(|d| d.as_secs_f64()).unwrap_or(0.0)
+    }
+
+    /// What the control loop does now, for `/diagnostics`: level and message.
+    fn loop_status(&self, now: f64) -> (u8, String) {
+        if let Command::Yielded(why) = &self.command {
+            return (level::ERROR, format!("not commanding: {why}"));
+        }
+        if let Command::Listening(_) = self.command {
+            return (level::OK, "listening for another task_controller before commanding".into());
+        }
+        if !self.active() {
+            let state = self.lifecycle.state().label();
+            return (level::WARN, format!("{state}: holding, zero commands until activated"));
+        }
+        match self.tc.freshness(now) {
+            Freshness::Fresh => (level::OK, "FRESH: commanding".into()),
+            Freshness::Waiting => (level::WARN, format!("WAITING for {}: zero commands", self.tc.missing().join(", "))),
+            Freshness::Stale { input, age_s, timeout_s } => (
+                level::ERROR,
+                format!("STALE: {input} {age_s:.3} s old (timeout {timeout_s} s): the commands ramp to zero"),
+            ),
+        }
+    }
+
+    /// Publishes the `/diagnostics` report of the last period.
+    fn report_diagnostics(&mut self) {
+        let now = self.now();
+        let (mut lvl, mut message) = self.loop_status(now);
+        let p = self.tc.params();
+        if self.period_timing.count > 0 && self.period_timing.max.as_secs_f64() > 1.0 / p.control_rate_hz {
+            lvl = lvl.max(level::WARN);
+            message += "; a cycle took longer than the control period";
+        }
+        let (cycles, faults) = self.tc.counts();
+        let lp = LoopReport {
+            level: lvl,
+            message,
+            lifecycle: self.lifecycle.state().label(),
+            rate_hz: p.control_rate_hz,
+            timing: std::mem::take(&mut self.period_timing),
+            cycles,
+            overruns: self.overruns,
+            late_periods: self.late_periods,
+            safe_stop_cycles: faults,
+            idle_periods: self.tc.idle_periods(),
+        };
+        let inputs = self.tc.input_ages(now);
+        let stamp = time_msg(system_now_s());
+        let report = self.diagnostics.report(stamp, &lp, &inputs, p.max_stamp_lead_s, self.tc.issues());
+        if let Err(e) = self.diagnostics_pub.publish(&report) {
+            if !std::mem::replace(&mut self.publish_failed, true) {
+                r2r::log_error!(&self.logger, "{}: {e}", diagnostics::TOPIC);
+            }
+        }
     }
 
     /// Logs a refused message the first time its kind occurs (all are counted).
@@ -354,7 +457,7 @@ impl TaskControllerHandle {
         let s = self.shared.borrow();
         let p = &s.pubs;
         match topic {
-            CMD_VEL => p.base.as_ref().map(|b| b.get_inter_process_subscription_count()),
+            CMD_VEL => p.base.as_ref().map(BasePublisher::subscription_count),
             CONTROLLER_STATE => Some(p.state.get_inter_process_subscription_count()),
             _ => s.topics.iter().position(|t| t == topic).map(|k| p.arms[k].get_inter_process_subscription_count()),
         }
@@ -451,11 +554,78 @@ fn declared_specs() -> Vec<ParamSpec> {
     specs
 }
 
+/// The system clock now \[s since the epoch\] (the stamp of `/diagnostics`, as diagnostic_updater's).
+fn system_now_s() -> f64 {
+    std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64())
+}
+
+/// A start-up flag: the ROS parameter `key`, else false.
+fn flag(node: &r2r::Node, key: &str) -> Result<bool> {
+    let v: Option<bool> = node.get_parameter(key).with_context(|| format!("ROS parameter `{key}`"))?;
+    Ok(v.unwrap_or(false))
+}
+
+/// Spins `node` until the URDF arrives on `topic` (`robot_description`, transient local: one
+/// published before this node started is delivered too); meanwhile `/diagnostics` says the
+/// controller is WAITING for it. Fails on an invalid URDF (naming the topic) and on a stop request.
+fn wait_for_description(
+    node: &mut r2r::Node,
+    topic: &str,
+    mobile_base: bool,
+    diagnostics: &Diagnostics,
+    diagnostics_pub: &r2r::Publisher<DiagnosticArray>,
+) -> Result<RobotModel> {
+    use futures::FutureExt as _;
+    let logger = node.logger().to_string();
+    let mut sub = node.subscribe::<StringMsg>(local(robot_description::TOPIC), qos::latched())?;
+    let what = format!("the URDF on {topic} (std_msgs/String, transient local, as robot_state_publisher publishes it)");
+    r2r::log_info!(&logger, "waiting for {what}");
+    let mut next_report = Instant::now();
+    loop {
+        if crate::shutdown::requested() {
+            anyhow::bail!("stopped while waiting for {what}");
+        }
+        if Instant::now() >= next_report {
+            diagnostics_pub.publish(&diagnostics.waiting(time_msg(system_now_s()), &what))?;
+            next_report += diagnostics::PERIOD;
+        }
+        node.spin_once(Duration::from_millis(50));
+        if let Some(Some(msg)) = sub.next().now_or_never() {
+            let model = robot_description::model(&msg.data, topic, mobile_base).map_err(anyhow::Error::msg)?;
+            r2r::log_info!(&logger, "{topic}: robot `{}`, {} joints", model.name(), model.nv());
+            return Ok(model);
+        }
+    }
+}
+
 /// Creates the node's parameters, subscriptions, publishers and timer, and spawns its tasks.
+/// With `use_robot_description` it first waits for the URDF on `robot_description`.
 pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> Result<TaskControllerHandle> {
     let logger = node.logger().to_string();
     let setup = file_setting(node, options.setup, "setup_file", "config/controller/tomm.yaml")?;
-    let config = ControllerConfig::load(&resolve(&setup, "setup_file")?).context("controller setup")?;
+    let setup_path = resolve(&setup, "setup_file")?;
+    let fqn = node.fully_qualified_name()?;
+    let diagnostics_pub = node.create_publisher::<DiagnosticArray>(diagnostics::TOPIC, qos::diagnostics())?;
+    let mut diagnostics = Diagnostics::new(&fqn, "none");
+    // The URDF: the setup's file, urdf_file, or the robot_description topic (exactly one).
+    let urdf_file = file_setting(node, None, "urdf_file", "")?;
+    let (use_topic, mobile_base) = (flag(node, "use_robot_description")?, flag(node, "mobile_base")?);
+    let (setup_read, _) = ControllerSetup::load(&setup_path).context("controller setup")?;
+    let topic = resolved(node, local(robot_description::TOPIC));
+    let source = robot_description::choose(&urdf_file, use_topic, setup_read.urdf.as_deref(), &setup, &topic)
+        .map_err(anyhow::Error::msg)?;
+    let model = match &source {
+        UrdfSource::Setup => None,
+        UrdfSource::File(f) => Some(RobotModel::from_urdf_file(&resolve(f, "urdf_file")?).context("urdf_file")?),
+        UrdfSource::Topic => {
+            if let Some(u) = &setup_read.urdf {
+                r2r::log_info!(&logger, "the URDF comes from {topic}: {setup}'s urdf {} is not read", u.display());
+            }
+            Some(wait_for_description(node, &topic, mobile_base, &diagnostics, &diagnostics_pub)?)
+        }
+    };
+    let config = ControllerConfig::load_with_model(&setup_path, model).context("controller setup")?;
+    diagnostics.set_hardware_id(config.model.name());
     let mut params =
         StructParams::new(TaskControllerParams::defaults(&config), TaskControllerParams::validate, DESCRIPTIONS)?
             .with_start_only(START_ONLY)
@@ -464,6 +634,21 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
                 "setup_file",
                 ParameterValue::String(setup.clone()),
                 "Controller setup file (read at start)",
+            )
+            .with_read_only(
+                "urdf_file",
+                ParameterValue::String(urdf_file),
+                "Robot URDF file instead of the setup's (empty: the setup's; read at start)",
+            )
+            .with_read_only(
+                "use_robot_description",
+                ParameterValue::Bool(use_topic),
+                "Take the URDF from the robot_description topic (transient local) instead of a file (read at start)",
+            )
+            .with_read_only(
+                "mobile_base",
+                ParameterValue::Bool(mobile_base),
+                "use_robot_description: the URDF is rooted at the base frame; the controller adds its planar base joints (read at start)",
             );
     params
         .apply_overrides(&node.params.lock().unwrap())
@@ -482,7 +667,11 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
             .iter()
             .map(|t| node.create_publisher::<Float64MultiArray>(local(t), qos::stream()))
             .collect::<r2r::Result<_>>()?,
-        base: if tc.has_base() { Some(node.create_publisher::<Twist>(local(CMD_VEL), qos::stream())?) } else { None },
+        base: match (tc.has_base(), initial.base_command_stamped) {
+            (false, _) => None,
+            (true, false) => Some(BasePublisher::Twist(node.create_publisher(local(CMD_VEL), qos::stream())?)),
+            (true, true) => Some(BasePublisher::Stamped(node.create_publisher(local(CMD_VEL), qos::stream())?)),
+        },
         state: node.create_publisher::<ControllerState>(local(CONTROLLER_STATE), qos::stream())?,
     };
     // The command topics as resolved in the node's namespace, for the log and subscriber counts.
@@ -492,8 +681,9 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     }
     // Resolved names: the watchdog (in any namespace) zeroes these very topics.
     let mut described: Vec<String> =
-        tc.arms().iter().map(|a| format!("{}={}", resolved(node, local(&a.topic)), a.joints.len())).collect();
-    described.extend(tc.has_base().then(|| resolved(node, local(CMD_VEL))));
+        tc.arms().iter().map(|a| CommandType::Arm(a.joints.len()).describe(&resolved(node, local(&a.topic)))).collect();
+    let base_type = if initial.base_command_stamped { CommandType::TwistStamped } else { CommandType::Twist };
+    described.extend(tc.has_base().then(|| base_type.describe(&resolved(node, local(CMD_VEL)))));
     let me = Commander::this_process(&described);
     let beat = Header { stamp: time_msg(0.0), frame_id: me.to_string() };
     // Timer mode (a robot): listen for another commander first. Lockstep: the simulation's only.
@@ -511,7 +701,6 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
         initial.supervisor,
         all_topics.join(", ")
     );
-    let fqn = node.fully_qualified_name()?;
     let shared = Rc::new(RefCell::new(Shared {
         lifecycle: Lifecycle::default(),
         transitions: node.create_publisher::<TransitionEvent>(&format!("{fqn}/transition_event"), qos::stream())?,
@@ -530,6 +719,11 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
         publish_failed: false,
         stale: false,
         timing: Timing::default(),
+        diagnostics,
+        diagnostics_pub,
+        period_timing: Timing::default(),
+        overruns: 0,
+        late_periods: 0,
     }));
 
     // Parameter requests are served on a thread of their own: a request of any size (each set
@@ -615,6 +809,14 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
         Ok(true) => r2r::log_info!(&s.logger, "{ARRANGEMENT}: following mode {} {:?}", msg.mode, msg.task_order),
         Ok(false) => {}
         Err(e) => s.refused(Err(e)),
+    })?;
+
+    let mut report_timer = node.create_wall_timer(diagnostics::PERIOD)?;
+    let reporter = shared.clone();
+    spawner.spawn_local(async move {
+        while report_timer.tick().await.is_ok() {
+            reporter.borrow_mut().report_diagnostics();
+        }
     })?;
 
     if initial.trigger == Trigger::Timer {

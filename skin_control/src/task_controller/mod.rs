@@ -118,6 +118,9 @@ pub struct TaskControllerParams {
     /// Timer mode: at start, listen this long for another controller's heartbeat on the same
     /// command topics before commanding (one commander; DDS discovery takes up to seconds) \[s\].
     pub commander_wait_s: f64,
+    /// The base command as `geometry_msgs/TwistStamped` (frame `base_link`, stamped with the
+    /// period's time), as ROS 2 Jazzy's ros2_control base controllers take it; false: `Twist`.
+    pub base_command_stamped: bool,
     /// Command topics per arm.
     pub arms: ArmsParams,
     /// Skin model (`config/skin_model.yaml`).
@@ -135,6 +138,7 @@ pub const START_ONLY: &[&str] = &[
     "use_scan",
     "autostart",
     "commander_wait_s",
+    "base_command_stamped",
     "arms.",
     "skin.",
     "tasks.",
@@ -153,6 +157,7 @@ pub const DESCRIPTIONS: &[(&str, &str)] = &[
     ("max_stamp_lead_s", "Timer mode: messages stamped more than this [s] ahead of the node's clock are refused, inputs whose age is below minus this are stale, in [0, 0.1] (settable)"),
     ("autostart", "Configure and activate the managed node at start; false: hold still (zero commands) until <node>/change_state activates it (start only)"),
     ("commander_wait_s", "Timer mode: at start, listen this long [s] for another task_controller's heartbeat on the same command topics before commanding; in [0, 10] (start only)"),
+    ("base_command_stamped", "Base command type: true: geometry_msgs/TwistStamped (frame base_link, the period's stamp; ros2_control's base controllers), false: geometry_msgs/Twist (start only)"),
     ("arms.namespaces", "Command namespaces, one per arm: <ns>/forward_velocity_controller/commands (start only)"),
     ("arms.joint_prefixes", "Joint-name prefix of each arm's joints, pairs with arms.namespaces (start only)"),
 ];
@@ -175,6 +180,7 @@ impl TaskControllerParams {
             max_stamp_lead_s: 0.02,
             autostart: true,
             commander_wait_s: 5.0,
+            base_command_stamped: false,
             arms,
             skin: config.skin,
             tasks: config.tasks.clone(),
@@ -255,6 +261,20 @@ pub enum Freshness {
         /// Its timeout \[s\].
         timeout_s: f64,
     },
+}
+
+/// One required input's age at a time ([`TaskController::input_ages`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputAge {
+    /// The topic.
+    pub topic: &'static str,
+    /// Clock minus the stamp of its last accepted value \[s\] (joint states: of the oldest joint);
+    /// None: not received yet.
+    pub age_s: Option<f64>,
+    /// Its timeout \[s\].
+    pub timeout_s: f64,
+    /// Joint states: the oldest joint, or the joints not received yet.
+    pub detail: Option<String>,
 }
 
 /// Where the input status of `/controller/state` comes from when no cycle ran.
@@ -660,6 +680,39 @@ impl TaskController {
             return None;
         }
         Some(required.into_iter().flatten().map(|(topic, t, timeout)| (topic, t.unwrap_or(f64::NAN), timeout)))
+    }
+
+    /// Every required input's age at `now_s` (the node's clock), in the order joint states,
+    /// odometry, skin cells, scan.
+    pub fn input_ages(&self, now_s: f64) -> Vec<InputAge> {
+        let p = &self.params;
+        let age = |t: Option<f64>| t.map(|t| now_s - t);
+        let joints = match self.state.oldest_joint() {
+            Some((name, t)) => InputAge {
+                topic: JOINT_STATES,
+                age_s: Some(now_s - t),
+                timeout_s: p.input_timeout_s,
+                detail: Some(format!("oldest joint `{name}`")),
+            },
+            None => {
+                let missing: Vec<&str> = self.state.missing().filter(|n| !self.is_base_joint(n)).collect();
+                InputAge {
+                    topic: JOINT_STATES,
+                    age_s: None,
+                    timeout_s: p.input_timeout_s,
+                    detail: Some(format!("no value yet of joint `{}`", missing.join("`, `"))),
+                }
+            }
+        };
+        let others = [
+            self.needs_odom.then(|| (ODOM, self.state.odom_time(), p.odom_timeout_s)),
+            self.needs_cells.then(|| (CELLS, self.health.last(Timed::Cells), p.cells_timeout_s)),
+            p.use_scan.then(|| (SCAN, self.health.last(Timed::Scan), p.scan_timeout_s)),
+        ];
+        let others = others.into_iter().flatten();
+        std::iter::once(joints)
+            .chain(others.map(|(topic, t, timeout_s)| InputAge { topic, age_s: age(t), timeout_s, detail: None }))
+            .collect()
     }
 
     /// Trigger `inputs`: the common stamp of a complete input set that is newer than the last

@@ -22,8 +22,10 @@ use crate::tasks::TaskError;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ControllerSetup {
-    /// Robot URDF.
-    pub urdf: PathBuf,
+    /// Robot URDF. Optional: a caller may give the robot's model instead
+    /// ([`ControllerConfig::load_with_model`]; the ROS node takes it from `robot_description`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub urdf: Option<PathBuf>,
     /// Skin layout (`skin::layout::SkinLayout`).
     pub skin_layout: PathBuf,
     /// Skin model parameters (`SkinParams`).
@@ -184,8 +186,10 @@ fn read_setup(path: &Path, depth: usize) -> Result<(ControllerSetup, String), Se
     let (mut merged, _) = read_setup(&path.parent().unwrap_or(Path::new(".")).join(&base), depth + 1)?;
     // the base's file paths, relative to the base's directory, made relative to this one's
     let base_dir = base.parent().unwrap_or(Path::new(""));
+    if let Some(urdf) = &mut merged.urdf {
+        *urdf = base_dir.join(&*urdf);
+    }
     for p in [
-        &mut merged.urdf,
         &mut merged.skin_layout,
         &mut merged.skin_model,
         &mut merged.tasks,
@@ -211,12 +215,27 @@ fn read_setup(path: &Path, depth: usize) -> Result<(ControllerSetup, String), Se
 }
 
 impl ControllerConfig {
-    /// Reads the setup file at `path` and everything it names (paths relative to its directory).
+    /// Reads the setup file at `path` and everything it names (paths relative to its directory);
+    /// the setup must name the URDF.
     pub fn load(path: &Path) -> Result<Self, SetupError> {
+        Self::load_with_model(path, None)
+    }
+
+    /// [`Self::load`] with the robot's model given by the caller (`Some`: the setup's `urdf`, if
+    /// any, is not read), else the URDF the setup names (an error names the `urdf` key when there
+    /// is none).
+    pub fn load_with_model(path: &Path, model: Option<RobotModel>) -> Result<Self, SetupError> {
         let (setup, source) = ControllerSetup::load(path)?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let at = |p: &Path| dir.join(p);
-        let model = RobotModel::from_urdf_file(&at(&setup.urdf))?;
+        let model = match (model, &setup.urdf) {
+            (Some(model), _) => model,
+            (None, Some(urdf)) => RobotModel::from_urdf_file(&at(urdf))?,
+            (None, None) => {
+                let reason = "not given: name the robot's URDF file (relative to this file)".to_string();
+                return Err(SetupError::Invalid { file: source, key: "urdf".into(), reason });
+            }
+        };
         let layout = SkinLayout::load(&at(&setup.skin_layout))?.resolve(&model)?;
         let mut supervisor = SupervisorParams::load(&at(&setup.supervisor))?;
         supervisor.policy = setup.policy.unwrap_or(supervisor.policy);

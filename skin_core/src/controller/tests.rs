@@ -135,6 +135,24 @@ fn setup_errors_name_file_and_key() {
 }
 
 #[test]
+fn a_setup_without_urdf_takes_the_callers_model() {
+    let text = std::fs::read_to_string(setup("planar7")).unwrap();
+    let urdf_line = text.lines().find(|l| l.starts_with("urdf:")).unwrap();
+    let path = setup("planar7").with_file_name(format!(".test_no_urdf_{}.yaml", std::process::id()));
+    std::fs::write(&path, text.replace(urdf_line, "")).unwrap();
+    let e = ControllerConfig::load(&path).unwrap_err().to_string();
+    let urdf = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../urdf/planar7.urdf");
+    let model = crate::model::RobotModel::from_urdf_str(&std::fs::read_to_string(urdf).unwrap(), "given").unwrap();
+    let given = ControllerConfig::load_with_model(&path, Some(model.clone()));
+    // a setup that names a URDF: the caller's model wins
+    let both = ControllerConfig::load_with_model(&setup("planar7"), Some(model)).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    assert!(e.contains("`urdf`") && e.contains("not given"), "{e}");
+    assert_eq!(given.unwrap().model.nv(), 7);
+    assert_eq!(both.model.source(), "given");
+}
+
+#[test]
 fn a_derived_setup_is_its_base_with_its_keys_replaced() {
     let (phases, _) = ControllerSetup::load(&setup("tomm_phases")).unwrap();
     let (tomm, _) = ControllerSetup::load(&setup("tomm")).unwrap();

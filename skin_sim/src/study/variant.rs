@@ -90,7 +90,10 @@ fn fit_sensor_rates(spec: &mut SceneSpec, timestep_s: f64) -> Vec<String> {
 fn write_variant(target: &RunTarget, point: &Point, id: usize, work: &Path) -> anyhow::Result<(PathBuf, SkinLayout)> {
     let (mut setup, source) = ControllerSetup::load(&target.controller)?;
     let dir = target.controller.parent().unwrap_or(Path::new(".")).canonicalize()?;
-    for p in [&mut setup.urdf, &mut setup.skin_model, &mut setup.tasks, &mut setup.supervisor, &mut setup.resolver] {
+    if let Some(urdf) = &mut setup.urdf {
+        *urdf = dir.join(&*urdf);
+    }
+    for p in [&mut setup.skin_model, &mut setup.tasks, &mut setup.supervisor, &mut setup.resolver] {
         *p = dir.join(&*p);
     }
     let layout = density::reduce(&SkinLayout::load(&dir.join(&setup.skin_layout))?, point.setting.density);

@@ -83,6 +83,7 @@ fn run() -> Result<Option<bool>> {
                 resend: 1.0,
                 arm_namespaces: vec![],
                 arm_prefixes: vec![],
+                base_command_stamped: false,
                 record: args.record.clone(),
                 out: args.out.clone(),
                 controller: args.setup.as_ref().map(PathBuf::from),

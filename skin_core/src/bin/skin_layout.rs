@@ -1,5 +1,6 @@
-//! `skin_layout`: generates a skin layout YAML by tiling hexagonal cells over the collision
-//! primitives of chosen URDF links (one patch per link).
+//! `skin_layout`: generates a skin layout YAML by tiling cells over the collision geometry of
+//! chosen URDF links (one patch per link): hexagonal grids on primitives, a Poisson-disk set on
+//! meshes (STL, OBJ, DAE; or on their fitted boxes with `--meshes box`).
 //!
 //! ```text
 //! skin_layout --urdf urdf/planar7.urdf --links link1,link2:0 --pitch 0.025 --out config/skin/planar7.yaml
@@ -8,11 +9,14 @@
 //! `--links` takes `link` (all its collision elements) or `link:i+j` (elements i, j in document
 //! order); `--faces link=+z,-z` restricts the box faces tiled on a link (default: all six);
 //! `--spheres` also tiles spheres; `--patch-frame link|primitive` places the patch frames.
+//! `package://` mesh URIs are searched in `--package-path` directories, then `ROS_PACKAGE_PATH`,
+//! then `AMENT_PREFIX_PATH` (`skin_core::mesh::package`).
 
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, ValueEnum};
+use skin_core::mesh::{MeshMode, PackagePath};
 use skin_core::model::RobotModel;
 use skin_core::skin::generate::{generate_layout, GeneratorSpec, LinkSelection, PatchFrame};
 use skin_core::skin::tiling::Face;
@@ -45,6 +49,13 @@ struct Args {
     /// Patch frame placement.
     #[arg(long, value_enum, default_value_t = FrameArg::Primitive)]
     patch_frame: FrameArg,
+    /// Mesh collision elements: cells on the mesh surface (`mesh`) or on its fitted box (`box`).
+    #[arg(long, default_value = "mesh")]
+    meshes: MeshMode,
+    /// Directory searched for `package://` mesh URIs before ROS_PACKAGE_PATH and
+    /// AMENT_PREFIX_PATH: one that contains package directories, or a package itself (repeatable).
+    #[arg(long)]
+    package_path: Vec<PathBuf>,
     /// Output YAML file.
     #[arg(long)]
     out: PathBuf,
@@ -83,6 +94,8 @@ fn main() -> Result<()> {
             FrameArg::Link => PatchFrame::Link,
             FrameArg::Primitive => PatchFrame::Primitive,
         },
+        meshes: args.meshes,
+        package_path: PackagePath::from_env(&args.package_path),
     };
     let layout = generate_layout(&model, &spec)?;
     // Sanity: the output must load and resolve like any other layout.

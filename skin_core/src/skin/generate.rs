@@ -102,14 +102,14 @@ pub enum GenerateError {
         count: usize,
     },
     /// A mesh of a link could not be found or read.
-    #[error("{urdf}: link `{link}`: {source}")]
+    #[error("{urdf}: link `{link}`: {error}")]
     Mesh {
         /// URDF file.
         urdf: String,
         /// Link name.
         link: String,
         /// Why.
-        source: MeshError,
+        error: MeshError,
     },
     /// Nothing could be tiled on a link.
     #[error("{urdf}: link `{link}`: no cells fit on its selected primitives at this pitch")]
@@ -199,10 +199,10 @@ pub fn generate_layout(model: &RobotModel, spec: &GeneratorSpec) -> Result<SkinL
         for &i in idx {
             let c = &collisions[i];
             let patch_from_primitive = link_from_patch.inverse() * c.origin;
-            let tiled = tile_shape(&c.shape, faces, spec, Path::new(&urdf)).map_err(|source| GenerateError::Mesh {
+            let tiled = tile_shape(&c.shape, faces, spec, Path::new(&urdf)).map_err(|error| GenerateError::Mesh {
                 urdf: urdf.clone(),
                 link: link.clone(),
-                source,
+                error,
             })?;
             for cell in tiled {
                 let p = patch_from_primitive * Point3::from(cell.position);

@@ -82,12 +82,12 @@ pub enum SetupChoiceError {
         reason: String,
     },
     /// An output file.
-    #[error("{file}: {source}")]
+    #[error("{file}: {error}")]
     Io {
         /// The file.
         file: String,
         /// Why.
-        source: std::io::Error,
+        error: std::io::Error,
     },
 }
 

@@ -16,9 +16,8 @@
 //! "best": the largest position manipulability `sqrt(det(J_p J_p^T))` of the arm joints. The
 //! goal is where the end effector goes when the sweep joint turns so that it moves [`CHORD_M`];
 //! the obstacle, a cylinder standing on the floor and reaching above the arm near it, is at the
-//! chord's middle, moved
-//! [`OBSTACLE_OFFSET_M`] away from the sweep axis: the straight path runs into it, and a push
-//! from the inside slides it out of the way.
+//! chord's middle, moved [`OBSTACLE_OFFSET_M`] away from the sweep axis: the straight path runs
+//! into it, and a push from the inside slides it out of the way.
 
 use nalgebra::{Matrix3, Matrix6xX, Vector3};
 use skin_core::model::{point_jacobian, update_kinematics, JointKind, ModelData};

@@ -36,7 +36,7 @@ fn list(v: &[f64]) -> String {
 }
 
 fn write(path: &Path, text: &str) -> Result<(), SetupChoiceError> {
-    std::fs::write(path, text).map_err(|source| SetupChoiceError::Io { file: path.display().to_string(), source })
+    std::fs::write(path, text).map_err(|error| SetupChoiceError::Io { file: path.display().to_string(), error })
 }
 
 /// Writes the three files into `dir` (created if missing); `command` is the command line, for
@@ -48,7 +48,7 @@ pub fn write_files(
     dir: &Path,
     command: &str,
 ) -> Result<Written, SetupChoiceError> {
-    std::fs::create_dir_all(dir).map_err(|source| SetupChoiceError::Io { file: dir.display().to_string(), source })?;
+    std::fs::create_dir_all(dir).map_err(|error| SetupChoiceError::Io { file: dir.display().to_string(), error })?;
     let name = &choices.name;
     let files = Written {
         layout: dir.join(format!("{name}_skin.yaml")),

@@ -41,6 +41,19 @@ pub enum MjcfError {
         /// Its collision element index.
         index: usize,
     },
+    /// A joint that moves in the scene without finite, positive velocity and effort limits.
+    #[error(
+        "joint `{joint}`: velocity limit {velocity}, effort limit {effort}: its velocity servo needs both finite and \
+         > 0 (URDF <limit velocity effort>), or freeze the joint (leave it out of robot.joints)"
+    )]
+    Limits {
+        /// The joint.
+        joint: String,
+        /// Its velocity limit.
+        velocity: f64,
+        /// Its effort limit.
+        effort: f64,
+    },
 }
 
 /// The whole MJCF document of `scene`.

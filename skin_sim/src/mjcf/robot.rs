@@ -94,6 +94,10 @@ pub(super) fn robot_xml(scene: &Scene) -> Result<RobotXml, MjcfError> {
     for j in (0..model.nv()).filter(|&j| scene.moving[j]) {
         let lim = model.joint_limits()[j];
         let name = &model.joint_names()[j];
+        let finite = |x: f64| x.is_finite() && x > 0.0;
+        if !(finite(lim.velocity) && finite(lim.effort)) {
+            return Err(MjcfError::Limits { joint: name.clone(), velocity: lim.velocity, effort: lim.effort });
+        }
         let _ = writeln!(
             actuators,
             "    <velocity name=\"{name}\" joint=\"{name}\" kv=\"{}\" forcerange=\"{} {}\" ctrlrange=\"{} {}\"/>",

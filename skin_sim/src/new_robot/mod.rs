@@ -151,6 +151,16 @@ impl Choices {
             arm.dedup();
             arm
         };
+        for &j in &arm {
+            let l = model.joint_limits()[j];
+            if !(l.velocity.is_finite() && l.velocity > 0.0 && l.effort.is_finite() && l.effort > 0.0) {
+                let reason = format!(
+                    "velocity limit {}, effort limit {}: the simulator's velocity servo needs both finite and > 0",
+                    l.velocity, l.effort
+                );
+                return Err(self.choice("--arm-joints", &model.joint_names()[j], reason));
+            }
+        }
         if arm.len() < 3 {
             return Err(self.choice(
                 "--arm-joints",

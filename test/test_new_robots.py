@@ -24,14 +24,32 @@ ROBOTS = {
     "ur10": ("ur_description/urdf/ur10_robot.urdf", ["--end-effector", "wrist_3_link"]),
     "kinova": ("kinova_description/robots/kinova.urdf", ["--end-effector", "j2s6s200_link_6"]),
     "xarm7": ("xarm_description/urdf/xarm7.urdf", ["--end-effector", "link7"]),
+    # The mobile manipulator: planar base joints added in front of its root, the base moves.
     "tiago": ("tiago_description/robots/tiago.urdf",
-              ["--end-effector", "arm_7_link",
+              ["--end-effector", "arm_7_link", "--mobile-base",
                "--arm-joints", ",".join(f"arm_{i}_joint" for i in range(1, 8))]),
+    # The same with its base (and torso) frozen.
+    "tiago_fixed": ("tiago_description/robots/tiago.urdf",
+                    ["--end-effector", "arm_7_link",
+                     "--arm-joints", ",".join(f"arm_{i}_joint" for i in range(1, 8))]),
 }
+
 
 def package_path():
     """The directory holding the `example-robot-data` package of the URDFs' package:// URIs."""
     return robots_dir().parent.parent
+
+
+def base_travel(bag, link):
+    """How far `link` got from its start in the run's /tf [m]."""
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+    with open(bag, "rb") as f:
+        xy = [(t.transform.translation.x, t.transform.translation.y)
+              for _, _, _, msg in make_reader(f, decoder_factories=[DecoderFactory()]).iter_decoded_messages(topics=["/tf"])
+              for t in msg.transforms if t.child_frame_id == link]
+    assert xy, f"no /tf of {link}"
+    return max(((x - xy[0][0]) ** 2 + (y - xy[0][1]) ** 2) ** 0.5 for x, y in xy)
 
 
 def setup(name, tmp_path, options=None):
@@ -60,6 +78,8 @@ def test_reach_past_a_movable_obstacle(name, tmp_path):
     assert metrics["max_contact_force_n"] <= metrics["eps_c_n"], metrics
     # Past the obstacle: the arm was stuck in front of it and switched to intentional contact.
     assert any(s["to"] == "intentional_contact" for s in metrics["arrangement_switches"]), metrics
+    if "--mobile-base" in ROBOTS[name][1]:
+        assert base_travel(tmp_path / "run" / "run.mcap", "base_footprint") > 0.05
 
 
 def test_choices_the_urdf_cannot_satisfy(tmp_path):

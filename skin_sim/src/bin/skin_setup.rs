@@ -15,6 +15,8 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::Parser;
 use skin_core::mesh::MeshMode;
+use skin_core::resolver::BASE_JOINTS;
+use skin_sim::new_robot::base::with_planar_base;
 use skin_sim::new_robot::{pose, write_files, Choices};
 
 /// Write a skin layout, a controller setup and a reach-past-an-obstacle scene for a URDF.
@@ -30,6 +32,11 @@ struct Args {
     /// The joints that move, comma-separated [default: every joint from the root to the end effector].
     #[arg(long, value_delimiter = ',')]
     arm_joints: Vec<String>,
+    /// Keep the mobile base moving: the URDF's base_x_joint, base_y_joint, base_yaw_joint, or,
+    /// when it has none, those joints added in front of its root link (written as
+    /// `<out>/<name>_mobile.urdf`); without it the base is frozen.
+    #[arg(long)]
+    mobile_base: bool,
     /// Links to cover with skin, comma-separated [default: the links the arm joints carry that
     /// have collision geometry].
     #[arg(long, value_delimiter = ',')]
@@ -73,12 +80,24 @@ fn run(args: Args) -> Result<()> {
         let v: f64 = v.trim().parse().with_context(|| format!("--initial `{kv}`: not a number"))?;
         initial.insert(k.trim().to_string(), v);
     }
+    let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("out").join(&name));
+    let mut urdf = args.urdf.clone();
+    if args.mobile_base {
+        let text = std::fs::read_to_string(&urdf).with_context(|| format!("reading {}", urdf.display()))?;
+        if !BASE_JOINTS.iter().all(|b| text.contains(&format!("\"{b}\""))) {
+            let mobile = with_planar_base(&text, &urdf).map_err(anyhow::Error::msg)?;
+            std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+            urdf = dir.join(format!("{name}_mobile.urdf"));
+            std::fs::write(&urdf, mobile).with_context(|| format!("writing {}", urdf.display()))?;
+        }
+    }
     let choices = Choices {
-        urdf: args.urdf.clone(),
+        urdf: urdf.clone(),
         name: name.clone(),
         end_effector: args.end_effector.clone(),
         arm_joints: args.arm_joints.clone(),
         skin_links: args.skin_links.clone(),
+        mobile_base: args.mobile_base,
         pitch_m: args.pitch,
         meshes: args.meshes,
         package_path: args.package_path.clone(),
@@ -91,9 +110,8 @@ fn run(args: Args) -> Result<()> {
     let skin_s = started.elapsed().as_secs_f64();
     let fixed: Vec<usize> = choices.initial.keys().filter_map(|k| robot.model.joint_index(k)).collect();
     let placement = pose::place(&robot, &resolved, &fixed).map_err(|reason| {
-        skin_sim::new_robot::SetupChoiceError::Placement { urdf: args.urdf.display().to_string(), reason }
+        skin_sim::new_robot::SetupChoiceError::Placement { urdf: urdf.display().to_string(), reason }
     })?;
-    let dir = args.out.clone().unwrap_or_else(|| PathBuf::from("out").join(&name));
     let command =
         std::iter::once("skin_setup".to_string()).chain(std::env::args().skip(1)).collect::<Vec<_>>().join(" ");
     let files = write_files(&choices, &robot, &placement, &dir, &command)?;

@@ -8,6 +8,7 @@
 //! floor and the arm well conditioned, a goal swept about a vertical arm joint, and a light
 //! cylinder standing between them, a little off the straight path so that a push slides it aside.
 
+pub mod base;
 pub mod pose;
 mod write;
 
@@ -16,6 +17,7 @@ use std::path::PathBuf;
 
 use skin_core::mesh::{MeshMode, PackagePath};
 use skin_core::model::RobotModel;
+use skin_core::resolver::BASE_JOINTS;
 use skin_core::skin::generate::{generate_layout, GeneratorSpec, LinkSelection, PatchFrame};
 use skin_core::skin::layout::SkinLayout;
 use thiserror::Error;
@@ -33,6 +35,11 @@ pub struct Choices {
     pub end_effector: String,
     /// The joints that move (none: every moving joint between the root and the end effector).
     pub arm_joints: Vec<String>,
+    /// Keep the mobile base moving: the URDF's planar base joints (`skin_core::resolver::BASE_JOINTS`;
+    /// `skin_setup` adds them with [`base::with_planar_base`] when the URDF has none) join the
+    /// moving joints (never the arm's: the start configuration is searched with the base at 0).
+    /// Without it a base is frozen.
+    pub mobile_base: bool,
     /// Links to cover with skin (none: every link with collision geometry that an arm joint
     /// moves, fingers included, whatever touches the obstacle must feel it; those on which no
     /// cell fits are left out).
@@ -100,6 +107,8 @@ pub struct Robot {
     pub ee: usize,
     /// Model indices of the arm joints, in model order.
     pub arm: Vec<usize>,
+    /// Model indices of the base joints when the base moves (x, y, yaw), else empty.
+    pub base: Vec<usize>,
     /// The generated skin layout.
     pub layout: SkinLayout,
     /// Where every joint starts or stays (the user's `initial`, else 0 clamped into the limits).
@@ -130,6 +139,8 @@ impl Choices {
             j = model.joint_parent(k);
         }
         chain.reverse();
+        let base_joint = |j: usize| BASE_JOINTS.contains(&model.joint_names()[j].as_str());
+        chain.retain(|&j| !base_joint(j));
         if chain.is_empty() {
             return Err(self.choice("--end-effector", &self.end_effector, "fixed to the root: no joint moves it"));
         }
@@ -161,6 +172,20 @@ impl Choices {
                 return Err(self.choice("--arm-joints", &model.joint_names()[j], reason));
             }
         }
+        let base = if self.mobile_base {
+            BASE_JOINTS
+                .iter()
+                .map(|b| {
+                    model.joint_index(b).ok_or_else(|| {
+                        let reason =
+                            format!("the URDF has no joint `{b}` (a mobile base is the joints {BASE_JOINTS:?})");
+                        self.choice("--mobile-base", b, reason)
+                    })
+                })
+                .collect::<Result<Vec<_>, _>>()?
+        } else {
+            Vec::new()
+        };
         if arm.len() < 3 {
             return Err(self.choice(
                 "--arm-joints",
@@ -221,6 +246,6 @@ impl Choices {
             }
             q_default[j] = q;
         }
-        Ok(Robot { model, ee, arm, layout, q_default })
+        Ok(Robot { model, ee, arm, base, layout, q_default })
     }
 }

@@ -1,7 +1,8 @@
 //! Where the generated scene puts the robot, the goal and the obstacle.
 //!
 //! The floor is [`EE_ABOVE_FLOOR_M`] below the end effector's start (the robot's fixed links may
-//! reach below it: MuJoCo does not collide them with the world; a mobile base stands in a pit).
+//! reach below it: MuJoCo does not collide them with the world; a frozen mobile base stands in a
+//! pit), and under a moving base ([`BASE_FLOOR_GAP_M`]).
 //! The start configuration is the best of [`SAMPLES`] deterministic samples of the arm joints
 //! within their limits (continuous joints in `[-pi, pi]`) that satisfy:
 //! - no skin cell seeing the floor: along its normal the floor is at least [`CELL_CLEARANCE_M`]
@@ -25,8 +26,10 @@ use skin_core::skin::layout::ResolvedLayout;
 
 use super::Robot;
 
-/// End-effector height above the floor at the start \[m\].
+/// End-effector height above the floor at the start \[m\] (at least: see [`BASE_FLOOR_GAP_M`]).
 pub const EE_ABOVE_FLOOR_M: f64 = 0.5;
+/// A moving base's floor is this far below its root, or lower \[m\].
+pub const BASE_FLOOR_GAP_M: f64 = 0.01;
 /// Distance to the floor along every cell's normal, at least \[m\] (proximity range 0.15 m).
 pub const CELL_CLEARANCE_M: f64 = 0.17;
 /// Straight-line distance from the start to the goal \[m\].
@@ -102,6 +105,18 @@ struct Candidate {
     top: f64,
 }
 
+/// The floor under an end effector at height `ee_z`: [`EE_ABOVE_FLOOR_M`] below it, and for a
+/// moving base at most [`BASE_FLOOR_GAP_M`] below the root (REP 105: a mobile base's root,
+/// `base_footprint`, is on the ground; a floor through a moving base would hold it fast).
+fn floor_z(robot: &Robot, ee_z: f64) -> f64 {
+    let below_ee = ee_z - EE_ABOVE_FLOOR_M;
+    if robot.base.is_empty() {
+        below_ee
+    } else {
+        below_ee.min(-BASE_FLOOR_GAP_M)
+    }
+}
+
 /// World positions and normals of the cells at the state in `data`.
 fn cell_positions(layout: &ResolvedLayout, data: &ModelData) -> Vec<(Vector3<f64>, Vector3<f64>)> {
     layout
@@ -133,7 +148,7 @@ pub fn place(robot: &Robot, layout: &ResolvedLayout, fixed: &[usize]) -> Result<
         }
         update_kinematics(model, &mut data, &q, &zero).expect("nv entries");
         let ee = data.frame_pose(robot.ee).translation.vector;
-        let floor = ee.z - EE_ABOVE_FLOOR_M;
+        let floor = floor_z(robot, ee.z);
         let cells = cell_positions(layout, &data);
         if cells
             .iter()
@@ -215,8 +230,8 @@ pub fn place(robot: &Robot, layout: &ResolvedLayout, fixed: &[usize]) -> Result<
         goal,
         sweep: c.sweep,
         obstacle_xy: c.obstacle_xy,
-        obstacle_height_m: c.top - (c.start.z - EE_ABOVE_FLOOR_M),
-        floor_z_m: c.start.z - EE_ABOVE_FLOOR_M,
+        obstacle_height_m: c.top - floor_z(robot, c.start.z),
+        floor_z_m: floor_z(robot, c.start.z),
     })
 }
 

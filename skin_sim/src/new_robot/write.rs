@@ -104,7 +104,7 @@ pub fn write_files(
         files.controller.display()
     );
     let _ = writeln!(s, "robot:\n  urdf: {urdf}");
-    let arm: Vec<&str> = robot.arm.iter().map(|&j| model.joint_names()[j].as_str()).collect();
+    let arm: Vec<&str> = robot.arm.iter().chain(&robot.base).map(|&j| model.joint_names()[j].as_str()).collect();
     let _ = writeln!(s, "  joints: [{}]", arm.join(", "));
     let _ = writeln!(s, "  initial:");
     for (j, q) in placement.q0.iter().enumerate() {

@@ -79,7 +79,7 @@ mod tests {
     #[test]
     fn adds_the_base_joints_in_front_of_the_root() {
         let urdf = r#"<robot name="r"><link name="a"><collision><geometry><mesh filename="meshes/a.stl"/></geometry></collision></link>
-            <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+            <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="1 0 0"/><limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
             <link name="b"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link></robot>"#;
         let out = with_planar_base(urdf, Path::new("/robots/r.urdf")).unwrap();
         assert!(out.contains("filename=\"/robots/meshes/a.stl\""), "{out}");

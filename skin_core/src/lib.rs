@@ -42,6 +42,7 @@ macro_rules! avx2_dispatch {
 
 pub mod controller;
 pub mod hierarchy;
+pub mod mesh;
 pub mod model;
 pub mod param_file;
 pub mod params_doc;

@@ -72,6 +72,7 @@ fn spec(links: &[&str], pitch: f64, faces: Vec<(String, Vec<Face>)>) -> Generato
         faces,
         spheres: false,
         patch_frame: PatchFrame::Primitive,
+        ..Default::default()
     }
 }
 

@@ -27,6 +27,7 @@ pub mod interaction;
 pub mod lidar;
 pub mod metrics;
 pub mod mjcf;
+pub mod new_robot;
 pub mod noise;
 pub mod outcome;
 pub mod outputs;

@@ -4,6 +4,7 @@ mod common;
 
 use common::{planar7, run, scene, scenes_dir, tomm_right_and_base, world};
 use mujoco_rs::prelude::*;
+use mujoco_rs::wrappers::mj_model::MjtGeomBase;
 use skin_sim::mjcf::ROBOT_GROUP;
 use skin_sim::{Scene, SceneError, World};
 
@@ -157,4 +158,63 @@ fn scene_errors_name_the_file_and_the_key() {
     assert!(matches!(Scene::from_yaml_str("robot: {urdf: x}\n", "bad.yaml", &scenes_dir()), Err(SceneError::Yaml(_))));
     // A valid scene text passes.
     scene(&planar7(""));
+}
+
+/// A one-link arm whose link is an ASCII STL cube (0.1 m, in package `cube_pkg`), and a scene
+/// file for it with `meshes` and the package path.
+fn mesh_scene(dir: &std::path::Path, meshes: &str, package_path: &str) -> Result<Scene, SceneError> {
+    let mesh_dir = dir.join("pkgs/cube_pkg/meshes");
+    std::fs::create_dir_all(&mesh_dir).unwrap();
+    let h = 0.05;
+    let v =
+        |i: usize| [if i & 1 == 0 { -h } else { h }, if i & 2 == 0 { -h } else { h }, if i & 4 == 0 { -h } else { h }];
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let mut stl = String::from("solid cube\n");
+    for q in quads {
+        for t in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
+            stl += "facet normal 0 0 0\nouter loop\n";
+            for i in t {
+                let p = v(i);
+                stl += &format!("vertex {} {} {}\n", p[0], p[1], p[2]);
+            }
+            stl += "endloop\nendfacet\n";
+        }
+    }
+    stl += "endsolid cube\n";
+    std::fs::write(mesh_dir.join("cube.stl"), stl).unwrap();
+    let urdf = r#"<robot name="cube_arm"><link name="base"/>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+        <limit lower="-3" upper="3" velocity="1" effort="10"/></joint>
+      <link name="arm"><inertial><mass value="1"/><origin xyz="0.2 0 0"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+        <collision><origin xyz="0.2 0 0"/><geometry><mesh filename="package://cube_pkg/meshes/cube.stl" scale="2 1 1"/></geometry></collision></link>
+    </robot>"#;
+    std::fs::write(dir.join("cube.urdf"), urdf).unwrap();
+    let text = format!(
+        "robot: {{urdf: cube.urdf, meshes: {meshes}, package_path: [{package_path}]}}\nduration_s: 1.0\nfloor_z_m: -1.0\n"
+    );
+    Scene::from_yaml_str(&text, "cube.yaml", dir)
+}
+
+#[test]
+fn mesh_collision_geometry_as_convex_mesh_or_fitted_box() {
+    let dir = std::env::temp_dir().join(format!("skin_sim_mesh_scene_{}", std::process::id()));
+    for (mode, geom_type) in [("mesh", MjtGeomBase::mjGEOM_MESH), ("box", MjtGeomBase::mjGEOM_BOX)] {
+        let scene = mesh_scene(&dir, mode, "pkgs").unwrap();
+        assert_eq!(scene.meshes.len(), 1);
+        let w = World::from_scene(scene).unwrap();
+        let m = w.mj_model();
+        let robot: Vec<usize> =
+            (0..m.ffi().ngeom as usize).filter(|&g| m.geom_group()[g] == ROBOT_GROUP as i32).collect();
+        assert_eq!(robot.len(), 1);
+        assert!(m.geom_type()[robot[0]] == geom_type, "{mode}");
+        // Either way the geom spans the scaled cube: 0.2 x 0.1 x 0.1 around (0.2, 0, 0).
+        let rbound = m.geom_rbound()[robot[0]];
+        assert!((rbound - (0.01f64 + 0.0025 + 0.0025).sqrt()).abs() < 1e-6, "{mode}: {rbound}");
+    }
+    let e = mesh_scene(&dir, "mesh", "elsewhere").unwrap_err().to_string();
+    assert!(
+        e.contains("robot.urdf") && e.contains("package://cube_pkg/meshes/cube.stl") && e.contains("elsewhere"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }

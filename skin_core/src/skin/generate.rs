@@ -1,13 +1,17 @@
-//! Building a [`SkinLayout`] by tiling the collision primitives of chosen links of a robot model
-//! (the library side of the `skin_layout` command; geometry in [`super::tiling`]).
+//! Building a [`SkinLayout`] by tiling the collision geometry of chosen links of a robot model
+//! (the library side of the `skin_layout` command; geometry in [`super::tiling`] for primitives
+//! and [`super::mesh_tiling`] for meshes, or their fitted boxes, [`MeshMode`]).
 
+use std::path::Path;
 use std::str::FromStr;
 
 use nalgebra::{Isometry3, Point3};
 use thiserror::Error;
 
 use super::layout::{CellSpec, PatchSpec, SkinLayout};
+use super::mesh_tiling::tile_mesh;
 use super::tiling::{tile_box, tile_cylinder, tile_sphere, Face, TiledCell};
+use crate::mesh::{self, MeshError, MeshMode, PackagePath};
 use crate::model::{RobotModel, Shape};
 
 /// A link to cover, optionally restricted to some of its collision elements.
@@ -50,7 +54,7 @@ pub enum PatchFrame {
 }
 
 /// What to generate.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct GeneratorSpec {
     /// Links to cover, in patch order. A link listed twice is one patch.
     pub links: Vec<LinkSelection>,
@@ -62,6 +66,13 @@ pub struct GeneratorSpec {
     pub spheres: bool,
     /// Placement of the patch frames.
     pub patch_frame: PatchFrame,
+    /// Mesh collision elements: tiled on their surface or on their fitted box.
+    pub meshes: MeshMode,
+    /// Where `package://` mesh URIs are searched.
+    pub package_path: PackagePath,
+    /// Leave out the links on which no cell fits (a finger smaller than the pitch) instead of
+    /// refusing them.
+    pub skip_empty: bool,
 }
 
 /// Errors of [`generate_layout`].
@@ -90,6 +101,16 @@ pub enum GenerateError {
         /// Number of collision elements.
         count: usize,
     },
+    /// A mesh of a link could not be found or read.
+    #[error("{urdf}: link `{link}`: {error}")]
+    Mesh {
+        /// URDF file.
+        urdf: String,
+        /// Link name.
+        link: String,
+        /// Why.
+        error: MeshError,
+    },
     /// Nothing could be tiled on a link.
     #[error("{urdf}: link `{link}`: no cells fit on its selected primitives at this pitch")]
     NoCells {
@@ -100,15 +121,34 @@ pub enum GenerateError {
     },
 }
 
-fn tile_shape(shape: &Shape, faces: &[Face], spheres: bool, pitch: f64) -> Vec<TiledCell> {
-    match shape {
+/// Cells on one collision element in its own frame (the element's `origin`). Box faces of a
+/// fitted mesh box are all six; the box's pose in the mesh frame is applied here.
+fn tile_shape(shape: &Shape, faces: &[Face], spec: &GeneratorSpec, urdf: &Path) -> Result<Vec<TiledCell>, MeshError> {
+    let pitch = spec.pitch_m;
+    Ok(match shape {
         Shape::Box { size } => tile_box(size, faces, pitch),
         Shape::Cylinder { radius, length } | Shape::Capsule { radius, length } => {
             tile_cylinder(*radius, *length, pitch)
         }
-        Shape::Sphere { radius } if spheres => tile_sphere(*radius, pitch),
-        Shape::Sphere { .. } | Shape::Mesh { .. } => Vec::new(),
-    }
+        Shape::Sphere { radius } if spec.spheres => tile_sphere(*radius, pitch),
+        Shape::Sphere { .. } => Vec::new(),
+        Shape::Mesh { filename, scale } => {
+            let m = mesh::load_uri(filename, scale, urdf, &spec.package_path)?;
+            match spec.meshes {
+                MeshMode::Mesh => tile_mesh(&m, pitch),
+                MeshMode::Box => {
+                    let (pose, size) = m.fitted_box();
+                    tile_box(&size, &Face::ALL, pitch)
+                        .into_iter()
+                        .map(|c| TiledCell {
+                            position: (pose * Point3::from(c.position)).coords,
+                            normal: pose.rotation * c.normal,
+                        })
+                        .collect()
+                }
+            }
+        }
+    })
 }
 
 /// Tiles the selected links of `model` (see [`super::tiling`] for the rules). Patch ids and
@@ -145,7 +185,7 @@ pub fn generate_layout(model: &RobotModel, spec: &GeneratorSpec) -> Result<SkinL
     }
     let mut layout = SkinLayout { source: urdf.clone(), robot: Some(model.name().to_string()), ..Default::default() };
     let mut next_cell = 1u32;
-    for (k, (link, idx)) in order.iter().enumerate() {
+    for (link, idx) in &order {
         let frame = model.frame_index(link).expect("checked above");
         let collisions = model.link_collisions(frame);
         let faces: &[Face] =
@@ -154,12 +194,17 @@ pub fn generate_layout(model: &RobotModel, spec: &GeneratorSpec) -> Result<SkinL
             (PatchFrame::Primitive, Some(&i)) => collisions[i].origin,
             _ => Isometry3::identity(),
         };
-        let patch_id = k as u32 + 1;
+        let patch_id = layout.patches.len() as u32 + 1;
         let first_cell = layout.cells.len();
         for &i in idx {
             let c = &collisions[i];
             let patch_from_primitive = link_from_patch.inverse() * c.origin;
-            for cell in tile_shape(&c.shape, faces, spec.spheres, spec.pitch_m) {
+            let tiled = tile_shape(&c.shape, faces, spec, Path::new(&urdf)).map_err(|error| GenerateError::Mesh {
+                urdf: urdf.clone(),
+                link: link.clone(),
+                error,
+            })?;
+            for cell in tiled {
                 let p = patch_from_primitive * Point3::from(cell.position);
                 let n = patch_from_primitive.rotation * cell.normal;
                 layout.cells.push(CellSpec {
@@ -173,6 +218,9 @@ pub fn generate_layout(model: &RobotModel, spec: &GeneratorSpec) -> Result<SkinL
             }
         }
         if layout.cells.len() == first_cell {
+            if spec.skip_empty {
+                continue;
+            }
             return Err(GenerateError::NoCells { urdf, link: link.clone() });
         }
         let (roll, pitch, yaw) = link_from_patch.rotation.euler_angles();

@@ -1,6 +1,6 @@
 //! MJCF (MuJoCo XML) generated from a [`Scene`]: the robot from its [`RobotModel`] (URDF
-//! collision primitives and merged inertials, velocity-servoed joints), the scene's objects and
-//! persons, a floor.
+//! collision primitives and meshes, merged inertials, velocity-servoed joints), the scene's
+//! objects and persons, a floor.
 //!
 //! Geom groups tell the sensors what they may see: the robot's geoms are in [`ROBOT_GROUP`], so
 //! skin and LIDAR rays (which only test [`SENSED_GROUPS`]) never hit the robot itself.
@@ -30,14 +30,29 @@ pub const PERSON_GROUP: u8 = 2;
 /// Groups the skin's and the LIDAR's rays test (`mj_ray`'s geomgroup): objects and persons.
 pub const SENSED_GROUPS: [u8; 6] = [1, 0, 1, 0, 0, 0];
 
-/// A robot MuJoCo cannot be given from primitives.
+/// A robot that cannot be written as MJCF.
 #[derive(Debug, Error)]
 pub enum MjcfError {
-    /// A link uses a mesh as collision geometry.
-    #[error("link `{link}`: mesh collision geometry is not supported (use URDF primitives)")]
+    /// A mesh collision element whose mesh the scene did not read (a scene built by hand).
+    #[error("link `{link}`: collision element {index} is a mesh the scene has not read")]
     Mesh {
         /// The URDF link.
         link: String,
+        /// Its collision element index.
+        index: usize,
+    },
+    /// A joint that moves in the scene without finite, positive velocity and effort limits.
+    #[error(
+        "joint `{joint}`: velocity limit {velocity}, effort limit {effort}: its velocity servo needs both finite and \
+         > 0 (URDF <limit velocity effort>), or freeze the joint (leave it out of robot.joints)"
+    )]
+    Limits {
+        /// The joint.
+        joint: String,
+        /// Its velocity limit.
+        velocity: f64,
+        /// Its effort limit.
+        effort: f64,
     },
 }
 
@@ -55,13 +70,16 @@ pub fn scene_xml(scene: &Scene) -> Result<String, MjcfError> {
         "  <option timestep=\"{}\" gravity=\"{} {} {}\" integrator=\"implicitfast\"/>",
         spec.timestep_s, g.x, g.y, g.z
     );
+    let robot = robot::robot_xml(scene)?;
+    if !robot.assets.is_empty() {
+        let _ = writeln!(xml, "  <asset>\n{}  </asset>", robot.assets);
+    }
     xml.push_str("  <worldbody>\n");
     let _ = writeln!(
         xml,
         "    <geom name=\"floor\" type=\"plane\" size=\"0 0 1\" pos=\"0 0 {}\" group=\"{OBJECT_GROUP}\"/>",
         spec.floor_z_m
     );
-    let robot = robot::robot_xml(scene)?;
     xml.push_str(&robot.bodies);
     for o in &spec.objects {
         objects::object_xml(o, &mut xml);

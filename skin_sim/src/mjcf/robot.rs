@@ -1,12 +1,14 @@
 //! The robot's part of the MJCF: one body per moving joint of the [`RobotModel`] (links joined by
-//! fixed joints are already merged there), its collision primitives and merged inertial, a joint
+//! fixed joints are already merged there), its collision geometry and merged inertial, a joint
 //! and a velocity servo when the joint moves in the scene, none (welded at its fixed position)
-//! when it is frozen.
+//! when it is frozen. Collision meshes are MuJoCo meshes given by their vertices (MuJoCo collides
+//! with their convex hull), or their fitted boxes (the scene's `robot.meshes`).
 
 use std::fmt::Write;
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
-use skin_core::model::{update_kinematics, JointKind, JointLimits, ModelData, RobotModel};
+use skin_core::mesh::MeshMode;
+use skin_core::model::{update_kinematics, JointKind, JointLimits, ModelData, RobotModel, Shape};
 
 use super::{pose_attrs, shape_attrs, MjcfError, ROBOT_GROUP};
 use crate::scene::Scene;
@@ -24,8 +26,9 @@ pub fn servo_gain(limits: &JointLimits) -> f64 {
     limits.effort / (SERVO_ERROR_FRACTION * limits.velocity)
 }
 
-/// The robot's XML pieces: bodies (inside `<worldbody>`), contact exclusions, actuators.
+/// The robot's XML pieces: mesh assets, bodies (inside `<worldbody>`), contact exclusions, actuators.
 pub(super) struct RobotXml {
+    pub(super) assets: String,
     pub(super) bodies: String,
     pub(super) contact: String,
     pub(super) actuators: String,
@@ -50,6 +53,7 @@ pub(super) fn robot_xml(scene: &Scene) -> Result<RobotXml, MjcfError> {
         .collect();
 
     let mut bodies = String::new();
+    let mut assets = String::new();
     // Links fixed to the world with geometry (e.g. planar7's base) are static bodies of their own:
     // MuJoCo never filters contacts with the world body itself, and such a link touches its child.
     let static_links: Vec<usize> = (0..model.nframes())
@@ -57,16 +61,17 @@ pub(super) fn robot_xml(scene: &Scene) -> Result<RobotXml, MjcfError> {
         .collect();
     for &f in &static_links {
         let _ = writeln!(bodies, "    <body name=\"{}\">", model.frame_names()[f]);
-        frame_geoms(model, f, "      ", &mut bodies)?;
+        frame_geoms(scene, f, "      ", &mut bodies, &mut assets)?;
         bodies.push_str("    </body>\n");
     }
     for root in (0..model.nv()).filter(|&j| model.joint_parent(j).is_none()) {
-        body_xml(scene, &placement, root, 2, &mut bodies)?;
+        body_xml(scene, &placement, root, 2, &mut bodies, &mut assets)?;
     }
 
     // Contacts of a body with its parent and grandparent are not meaningful: they overlap at the
     // joints (UR wrists). MuJoCo's own parent filter misses a parent welded to the world (a frozen
-    // base), so both are excluded explicitly, as are the static links and the root bodies.
+    // base), so both are excluded explicitly, as are the static links and the root bodies and
+    // their children (a Tiago's first arm link touches the torso column its parent slides on).
     let mut contact = String::from("  <contact>\n");
     let mut exclude = |a: &str, b: &str| {
         let _ = writeln!(contact, "    <exclude body1=\"{a}\" body2=\"{b}\"/>");
@@ -76,7 +81,8 @@ pub(super) fn robot_xml(scene: &Scene) -> Result<RobotXml, MjcfError> {
         for a in [parent, parent.and_then(|p| model.joint_parent(p))].into_iter().flatten() {
             exclude(body_name(model, a), body_name(model, j));
         }
-        if parent.is_none() {
+        // The links fixed to the world are the parent of a root body, the grandparent of its children.
+        if parent.and_then(|p| model.joint_parent(p)).is_none() {
             for &f in &static_links {
                 exclude(&model.frame_names()[f], body_name(model, j));
             }
@@ -88,6 +94,10 @@ pub(super) fn robot_xml(scene: &Scene) -> Result<RobotXml, MjcfError> {
     for j in (0..model.nv()).filter(|&j| scene.moving[j]) {
         let lim = model.joint_limits()[j];
         let name = &model.joint_names()[j];
+        let finite = |x: f64| x.is_finite() && x > 0.0;
+        if !(finite(lim.velocity) && finite(lim.effort)) {
+            return Err(MjcfError::Limits { joint: name.clone(), velocity: lim.velocity, effort: lim.effort });
+        }
         let _ = writeln!(
             actuators,
             "    <velocity name=\"{name}\" joint=\"{name}\" kv=\"{}\" forcerange=\"{} {}\" ctrlrange=\"{} {}\"/>",
@@ -99,7 +109,7 @@ pub(super) fn robot_xml(scene: &Scene) -> Result<RobotXml, MjcfError> {
         );
     }
     actuators.push_str("  </actuator>\n");
-    Ok(RobotXml { bodies, contact, actuators })
+    Ok(RobotXml { assets, bodies, contact, actuators })
 }
 
 /// The body of joint `j` and, recursively, its children.
@@ -109,6 +119,7 @@ fn body_xml(
     j: usize,
     depth: usize,
     xml: &mut String,
+    assets: &mut String,
 ) -> Result<(), MjcfError> {
     let model = &scene.model;
     let pad = "  ".repeat(depth);
@@ -153,10 +164,10 @@ fn body_xml(
         );
     }
     for f in (0..model.nframes()).filter(|&f| model.frame_parent_joint(f) == Some(j)) {
-        frame_geoms(model, f, &format!("{pad}  "), xml)?;
+        frame_geoms(scene, f, &format!("{pad}  "), xml, assets)?;
     }
     for child in (0..model.nv()).filter(|&k| model.joint_parent(k) == Some(j)) {
-        body_xml(scene, placement, child, depth + 1, xml)?;
+        body_xml(scene, placement, child, depth + 1, xml, assets)?;
     }
     let _ = writeln!(xml, "{pad}</body>");
     Ok(())
@@ -171,11 +182,34 @@ fn joint_motion(model: &RobotModel, j: usize, q: f64) -> Isometry3<f64> {
     }
 }
 
-/// The collision primitives of frame `f`, placed in the frame's body.
-fn frame_geoms(model: &RobotModel, f: usize, pad: &str, xml: &mut String) -> Result<(), MjcfError> {
-    for c in model.link_collisions(f) {
+/// The collision geometry of frame `f`, placed in the frame's body; meshes as assets.
+fn frame_geoms(scene: &Scene, f: usize, pad: &str, xml: &mut String, assets: &mut String) -> Result<(), MjcfError> {
+    let model = &scene.model;
+    for (i, c) in model.link_collisions(f).iter().enumerate() {
         let pose = model.frame_placement(f) * c.origin;
-        let shape = shape_attrs(&c.shape).ok_or_else(|| MjcfError::Mesh { link: model.frame_names()[f].clone() })?;
+        let (shape, pose) = match (&c.shape, scene.spec.robot.meshes) {
+            (Shape::Mesh { .. }, mode) => {
+                let link = &model.frame_names()[f];
+                let mesh = scene.meshes.get(&(f, i)).ok_or_else(|| MjcfError::Mesh { link: link.clone(), index: i })?;
+                match mode {
+                    MeshMode::Mesh => {
+                        let name = format!("{link}_collision_{i}");
+                        let mut seen = std::collections::HashSet::new();
+                        let mut vertex = String::new();
+                        for v in mesh.vertices.iter().filter(|v| seen.insert(v.map(f64::to_bits))) {
+                            let _ = write!(vertex, "{} {} {} ", v.x, v.y, v.z);
+                        }
+                        let _ = writeln!(assets, "    <mesh name=\"{name}\" vertex=\"{}\"/>", vertex.trim_end());
+                        (format!("type=\"mesh\" mesh=\"{name}\""), pose)
+                    }
+                    MeshMode::Box => {
+                        let (box_pose, size) = mesh.fitted_box();
+                        (shape_attrs(&Shape::Box { size }).expect("a box"), pose * box_pose)
+                    }
+                }
+            }
+            (shape, _) => (shape_attrs(shape).expect("a primitive"), pose),
+        };
         let _ = writeln!(xml, "{pad}<geom {shape} {} group=\"{ROBOT_GROUP}\"/>", pose_attrs(&pose));
     }
     Ok(())

@@ -6,9 +6,11 @@
 mod check;
 pub mod spec;
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use skin_core::model::RobotModel;
+use skin_core::mesh::{self, PackagePath, TriMesh};
+use skin_core::model::{RobotModel, Shape};
 use skin_core::param_file::yaml::{self, YamlError};
 use skin_core::resolver::BASE_JOINTS;
 use skin_core::skin::layout::{ResolvedLayout, SkinLayout};
@@ -78,6 +80,8 @@ pub struct Scene {
     pub skin: Option<SceneSkin>,
     /// The URDF text of the robot (what `/robot_description` carries).
     pub robot_description: String,
+    /// The mesh collision elements of the robot, by (frame, collision index), read from their files.
+    pub meshes: BTreeMap<(usize, usize), TriMesh>,
 }
 
 impl Scene {
@@ -98,6 +102,8 @@ impl Scene {
             .map_err(|e| invalid(reject("robot.urdf", format!("{}: {e}", urdf.display()))))?;
         let model = RobotModel::from_urdf_str(&robot_description, &urdf.display().to_string())
             .map_err(|e| invalid(reject("robot.urdf", e.to_string())))?;
+        let dirs: Vec<PathBuf> = spec.robot.package_path.iter().map(|p| resolve(dir, p)).collect();
+        let meshes = load_meshes(&model, &urdf, &PackagePath::from_env(&dirs)).map_err(invalid)?;
         let (moving, q0) = joint_setup(&spec.robot, &model).map_err(invalid)?;
         check_frames(&spec, &model).map_err(invalid)?;
         let base_moves = BASE_JOINTS.iter().filter_map(|b| model.joint_index(b)).any(|j| moving[j]);
@@ -111,7 +117,7 @@ impl Scene {
             Some(s) => Some(load_skin(s, dir, &model).map_err(invalid)?),
             None => None,
         };
-        Ok(Scene { spec, file: source.to_string(), model, moving, q0, skin, robot_description })
+        Ok(Scene { spec, file: source.to_string(), model, moving, q0, skin, robot_description, meshes })
     }
 
     /// Replaces the run settings (`duration_s`, `timestep_s`, `control_rate_hz`, `seed`; None
@@ -158,6 +164,25 @@ fn resolve(dir: &Path, p: &Path) -> PathBuf {
     } else {
         dir.join(p)
     }
+}
+
+/// Every mesh collision element of `model` (the URDF file `urdf`), read.
+fn load_meshes(
+    model: &RobotModel,
+    urdf: &Path,
+    path: &PackagePath,
+) -> Result<BTreeMap<(usize, usize), TriMesh>, Rejected> {
+    let mut out = BTreeMap::new();
+    for f in 0..model.nframes() {
+        for (i, c) in model.link_collisions(f).iter().enumerate() {
+            if let Shape::Mesh { filename, scale } = &c.shape {
+                let m = mesh::load_uri(filename, scale, urdf, path)
+                    .map_err(|e| reject("robot.urdf", format!("link `{}`: {e}", model.frame_names()[f])))?;
+                out.insert((f, i), m);
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// Which joints move and where every joint starts, in model order.

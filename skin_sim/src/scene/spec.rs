@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
+use skin_core::mesh::MeshMode;
 
 /// One scene file. Relative paths are relative to the scene file's directory.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -100,6 +101,15 @@ pub struct RobotSpec {
     /// joints stay. Unlisted joints: 0.
     #[serde(default)]
     pub initial: BTreeMap<String, f64>,
+    /// Mesh collision elements of the URDF: `mesh` (MuJoCo collides with each mesh's convex
+    /// hull) or `box` (with its fitted box, the primitive approximation). Generate the skin
+    /// layout with the same choice (`skin_layout --meshes`) so the cells lie on what collides.
+    #[serde(default)]
+    pub meshes: MeshMode,
+    /// Directories searched for `package://` mesh URIs (relative to the scene file), before
+    /// `ROS_PACKAGE_PATH` and `AMENT_PREFIX_PATH` (`skin_core::mesh::package`).
+    #[serde(default)]
+    pub package_path: Vec<PathBuf>,
 }
 
 /// The simulated skin.

@@ -18,7 +18,7 @@ use skin_core::model::RobotModel;
 use skin_core::skin::generate::{generate_layout, GeneratorSpec, LinkSelection, PatchFrame};
 use skin_core::skin::layout::ResolvedLayout;
 use skin_core::skin::tiling::Face;
-use support::{bench, readings, scan, tomm_config, Point};
+use support::{bench, readings, scan, selected, tomm_config, Point};
 
 /// Cell counts of the cells' series.
 const CELLS: [usize; 4] = [700, 2000, 5000, 10000];
@@ -65,11 +65,15 @@ fn tomm_layout_with(model: &RobotModel, cells: usize) -> ResolvedLayout {
 
 fn cells(c: &mut Criterion) {
     for n in CELLS {
+        let id = format!("controller_update_tomm_cells_{n}");
+        if !selected(&id) {
+            continue; // the layout's bisection is the slow part of the setup
+        }
         let mut cfg = tomm_config();
         cfg.layout = tomm_layout_with(&cfg.model, n);
         let cells = readings(&cfg.layout, 12, 24, &[8, 12]);
         let ctl = Controller::new(cfg, 0.0).unwrap();
-        bench(c, Point::new(format!("controller_update_tomm_cells_{n}"), ctl, cells, scan()));
+        bench(c, Point::new(id, ctl, cells, scan()));
     }
 }
 

@@ -100,17 +100,20 @@ const BATCH: usize = 8;
 pub fn bench(c: &mut Criterion, p: Point) {
     let Point { id, mut ctl, q, cells, scan } = p;
     let qd: Vec<f64> = (0..q.len()).map(|i| 0.02 * ((i as f64) * 0.7).sin()).collect();
-    let mut t = 0.0;
-    let mut step = |ctl: &mut Controller| {
-        t += 0.008;
-        let out = ctl.update(&ControllerInput { t_s: t, dt_s: 0.008, q: &q, qd: &qd, cells: &cells, scan: &scan });
+    // each controller with its own clock: the timed copy's cycles do not move the measured one's
+    let step = |ctl: &mut Controller, t: &mut f64| {
+        *t += 0.008;
+        let out = ctl.update(&ControllerInput { t_s: *t, dt_s: 0.008, q: &q, qd: &qd, cells: &cells, scan: &scan });
         assert!(out.fault.is_none(), "{id}: {:?}", out.fault);
         black_box(out.commands.joint_velocities[0]);
     };
-    if std::env::args().any(|a| a == "--bench") && c_matches(&id) {
-        let mut timed = ctl.clone();
+    let args: Vec<String> = std::env::args().collect();
+    // not in criterion's profiling mode (`--profile-time`, e.g. under callgrind): only the cycles
+    let measuring = args.iter().any(|a| a == "--bench") && !args.iter().any(|a| a == "--profile-time");
+    if measuring && selected(&id) {
+        let (mut timed, mut t) = (ctl.clone(), 0.0);
         for _ in 0..200 {
-            step(&mut timed);
+            step(&mut timed, &mut t);
         }
         // per stage the median over batches of cycles: a batch the scheduler interrupted (a
         // busy machine) counts once, not with its whole pause
@@ -118,7 +121,7 @@ pub fn bench(c: &mut Criterion, p: Point) {
             .map(|_| {
                 timed.set_stage_timing(true);
                 for _ in 0..BATCH {
-                    step(&mut timed);
+                    step(&mut timed, &mut t);
                 }
                 let times = timed.stage_times().unwrap();
                 Stage::ALL.map(|s| times.total_ns(s) as f64)
@@ -139,18 +142,28 @@ pub fn bench(c: &mut Criterion, p: Point) {
         entry.insert("joints".to_string(), cfg.model.nv() as f64);
         entry.insert("levels".to_string(), timed.level_diagnostics().len() as f64);
         entry.insert("level_rows".to_string(), rows as f64);
+        entry.insert("load_average".to_string(), load_average());
         for (s, m) in Stage::ALL.iter().zip(&median) {
             entry.insert(format!("share_{}", s.name()), m / total);
         }
         record_stages(&id, entry);
     }
-    c.bench_function(&id, |b| b.iter(|| step(&mut ctl)));
+    let mut t = 0.0;
+    c.bench_function(&id, |b| b.iter(|| step(&mut ctl, &mut t)));
 }
 
-/// Whether criterion's name filter (the first free argument after `--bench`) selects `id`.
-fn c_matches(id: &str) -> bool {
-    let filter = std::env::args().skip(1).find(|a| !a.starts_with('-') && !a.parse::<f64>().is_ok());
+/// Whether criterion's name filter (the first free argument) selects `id` (a substring; no
+/// filter selects all): the points' setup and stage timing are skipped for the others.
+pub fn selected(id: &str) -> bool {
+    let filter = std::env::args().skip(1).find(|a| !a.starts_with('-') && a.parse::<f64>().is_err());
     filter.is_none_or(|f| id.contains(&f))
+}
+
+/// The machine's 1-minute load average (`/proc/loadavg`; NaN where there is none): a busy
+/// machine's figures are not comparable with a quiet one's.
+fn load_average() -> f64 {
+    let text = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    text.split_whitespace().next().and_then(|v| v.parse().ok()).unwrap_or(f64::NAN)
 }
 
 /// Merges one point into `out/bench/stages.json` (point id -> figure -> value).

@@ -717,7 +717,10 @@ fn first_non_finite(x: &[f64]) -> Option<usize> {
     let tail = blocks.remainder();
     for b in blocks {
         for (a, v) in acc.iter_mut().zip(b) {
-            *a += v - v;
+            #[allow(clippy::eq_op)] // NaN for NaN and ±∞: the point
+            {
+                *a += v - v;
+            }
         }
     }
     if acc.iter().all(|&a| a == 0.0) && tail.iter().all(|v| v.is_finite()) {

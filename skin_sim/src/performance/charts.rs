@@ -8,7 +8,7 @@ use plotters::prelude::*;
 use skin_core::controller::Stage;
 
 use super::Series;
-use crate::plot::{font, FONT, PALETTE};
+use crate::plot::{font, legend, FONT, PALETTE};
 
 fn err(e: impl std::fmt::Display) -> anyhow::Error {
     anyhow!("{e}")
@@ -62,13 +62,6 @@ pub fn stacked(series: &Series, path: &Path) -> anyhow::Result<()> {
             Text::new(format!("{:.1}", p.total_ns * 1e-3), (x - half, p.total_ns * 1e-3 + top * 0.01), (FONT, 11))
         }))
         .map_err(err)?;
-    chart
-        .configure_series_labels()
-        .label_font((FONT, 12))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.3))
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperLeft).map_err(err)?;
     root.present().map_err(err)
 }

@@ -105,14 +105,24 @@ pub fn render(series: &[Series], sources: [&Path; 2], stem: &str) -> String {
     out.push_str(
         "How the cost of one control cycle, `Controller::update`, grows with the number of skin cells, of \
          active cells and of joints. Each point is a criterion benchmark of `skin_core` (`benches/scale.rs`, \
-         `benches/controller.rs`): the total is criterion's median; the stage shares come from 2 000 cycles \
-         of the same point timed stage by stage (`Controller::set_stage_timing`, one clock read per stage \
-         boundary), and a stage's time is its share of the median. The stages: **skin** (the scan for live \
+         `benches/controller.rs`): the total is criterion's median; the stage shares come from the same \
+         point timed stage by stage (`Controller::set_stage_timing`, one clock read per stage boundary) \
+         in 301 batches of 8 cycles, each stage's median over the batches (a batch the scheduler \
+         interrupted counts once), and a stage's time is its share of the median. The stages: **skin** (the scan for live \
          cells, their distances, the supervisor's signals and arrangement, patch wrenches and hand signals), \
          **dynamics** (kinematics, gravity, CRBA and RNEA), **tasks** (rows, Jacobians, references, the \
          posture torque), **hierarchy** (interactive-force-control paper eq. 19-25 with the Cholesky \
          inverse of `M`, and the blend), **resolver** (eq. 26 and the limits).\n\n",
     );
+    let loads: Vec<f64> =
+        series.iter().flat_map(|s| s.points.iter().map(|p| p.1.load_average)).filter(|l| l.is_finite()).collect();
+    if let (Some(lo), Some(hi)) = (loads.iter().copied().reduce(f64::min), loads.iter().copied().reduce(f64::max)) {
+        let _ = writeln!(
+            out,
+            "The machine's 1-minute load average during the measurements: {lo:.1}-{hi:.1} (on 2 cores: above \
+             about 1 the times include waits for a core and are not figures of record).\n"
+        );
+    }
     if let Some(j) = find(series, "joints") {
         out.push_str("## Joints\n\n");
         let _ = writeln!(out, "![{}]({stem}/{}.png)\n", j.title, j.key);

@@ -31,6 +31,8 @@ pub struct BenchPoint {
     pub level_rows: f64,
     /// Fraction of the time in each stage, in [`Stage::ALL`] order.
     pub shares: [f64; 5],
+    /// The machine's 1-minute load average when the point was measured (NaN: not recorded).
+    pub load_average: f64,
 }
 
 impl BenchPoint {
@@ -101,6 +103,7 @@ pub fn load(summary: &Path, stages: &Path) -> anyhow::Result<Vec<Series>> {
             levels: get("levels")?,
             level_rows: get("level_rows")?,
             shares,
+            load_average: f.get("load_average").copied().unwrap_or(f64::NAN),
         }))
     };
     let mut all = Vec::new();

@@ -170,14 +170,16 @@ pub fn render(series: &[Series], sources: [&Path; 2], stem: &str) -> String {
         );
         out.push_str(if key == "range" {
             "Why: each cell in range is one avoidance row (intentional-contact paper eq. 3): its distance, \
-             a point Jacobian (n per row) and, in the hierarchy, either a row of its own projected one at a \
-             time (inside the activation band, 4 n² each) or, once a level has more rows than joints, a \
-             share of `J̄ᵀ J̄` (n² per row) with the rest done once in joint space (n³). All of it is linear \
-             in the active cells: no m × m matrix is formed.\n\n"
+             a point Jacobian (n per row) and, in the hierarchy, a row projected on its own with its \
+             activation (continuous null-space projection: four n × n products per row, the level's \
+             main cost). A plain level with more rows than joints (contact reaction) is computed in joint \
+             space instead: n² per row and n³ once. All of it is linear in the active cells: no m × m \
+             matrix is formed.\n\n"
         } else {
-            "Why: a touched cell adds to its patch's wrench (interactive-force-control paper eq. 6-8) and \
-             the wrenches feed the tactile guidance, the wrist and the body compliance of eq. (13)-(14): a \
-             sum per live cell, linear with a small constant; the levels keep their rows.\n\n"
+            "Why: a touched cell's proximity signal is 1, so it is also an avoidance row, as a cell in \
+             range (the same linear cost per row); its force adds to its patch's wrench \
+             (interactive-force-control paper eq. 6-8), which feeds the tactile guidance, the wrist and \
+             the body compliance of eq. (13)-(14): a sum per live cell.\n\n"
         });
     }
     out.push_str("## What dominates\n\n");

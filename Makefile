@@ -12,7 +12,7 @@ MSG_SRCS := $(wildcard skin_msgs/msg/*.msg skin_msgs/srv/*.srv) skin_msgs/CMakeL
 MSG_SRCS += $(wildcard $(DEPS)/ros/install/.ros2-jazzy-python.stamp)
 CARGO_PROFILE ?= dev
 
-.PHONY: help bootstrap msgs build lint test test-rust test-robot-package test-integration run demo bench study campaign clean fuzz test-fuzz
+.PHONY: help bootstrap msgs build lint test test-rust test-robot-package test-integration run demo bench performance study campaign clean fuzz test-fuzz
 
 help:
 	@echo "make demo   bootstrap, build, run the main job: the intentional_contact scenario (see README.md)"
@@ -21,6 +21,7 @@ help:
 	@echo "make fuzz   fuzz skin_core with libFuzzer on stable, FUZZ_SECONDS per target (default 600; docs/fuzzing.md)"
 	@echo "make bench  run the benchmarks; figures in out/bench/summary.json"
 	@echo "make campaign  randomized scene campaign (200 scenes): out/campaign/summary.json, docs/robustness.md"
+	@echo "make performance  docs/performance.md and docs/performance/*.png from the results of make bench"
 	@echo "make study  speed/accuracy study (rate, timestep, skin density, inverse damping): out/study/results.json,"
 	@echo "            docs/tradeoffs.md and docs/tradeoffs/*.png; STUDY_ARGS=--full for the whole grid (long)"
 	@echo "make clean  remove build outputs (keeps .deps; rm -rf .deps for a full reset)"
@@ -89,6 +90,12 @@ demo: build
 
 bench: build
 	@$(ENV) scripts/bench
+
+# Cost curves of the control cycle over cells, active cells and joints, from `make bench`'s results
+# (out/bench/summary.json, out/bench/stages.json).
+performance: bootstrap
+	@echo "[make] skin_sim performance"
+	@$(ENV) cargo run --quiet -p skin_sim --bin skin_sim -- performance
 
 # The speed/accuracy study: the default grid runs in ~2-3 min on 2 cores with the debug profile
 # (opt-level 1, shared with `make test`); only skin_sim is built (no ROS messages needed).

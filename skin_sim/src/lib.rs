@@ -15,7 +15,8 @@
 //!   turns a run into `figure.png`, `run.mcap` and the rendered frames of its [`view`] (what
 //!   RViz would show: robot, skin markers, contact arrows);
 //! - [`study`]: the speed/accuracy study over control rate, timestep, skin density and the
-//!   inverse's damping (`skin_sim sweep`, `docs/tradeoffs.md`).
+//!   inverse's damping (`skin_sim sweep`, `docs/tradeoffs.md`);
+//! - [`performance`]: `docs/performance.md` from the benchmark results (`skin_sim performance`).
 #![warn(missing_docs)]
 
 pub mod base_motion;
@@ -31,6 +32,7 @@ pub mod new_robot;
 pub mod noise;
 pub mod outcome;
 pub mod outputs;
+pub mod performance;
 pub mod plot;
 pub mod probe;
 mod proximity_rays;

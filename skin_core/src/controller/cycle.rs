@@ -4,6 +4,7 @@ use nalgebra::{DMatrix, DVector, Isometry3};
 
 use super::io::{ControllerInput, ControllerOutput, Fault};
 use super::setup::{ControllerConfig, HierarchyDynamics, SetupError};
+use super::stages::{Stage, StageClock, StageTimes};
 use super::task_set::TaskSet;
 use crate::hierarchy::{HierarchySolver, LevelDiagnostics};
 use crate::model::{gravity, point_velocity, update_kinematics, ModelData};
@@ -83,6 +84,8 @@ pub struct Controller {
     /// A cycle has run on a valid measured state (the position hold captures its pose then).
     started: bool,
     output: ControllerOutput,
+    /// Opt-in stage timing ([`Controller::set_stage_timing`]).
+    clock: StageClock,
 }
 
 impl Controller {
@@ -169,6 +172,7 @@ impl Controller {
             bias: DVector::zeros(nv),
             started: false,
             output,
+            clock: StageClock::default(),
             tasks,
             proximity_signal: ProximityAvoidance::new(nv, config.tasks.avoidance),
             contact_signal: ContactReaction::new(nv, config.tasks.contact_reaction, &config.skin.force),
@@ -289,6 +293,17 @@ impl Controller {
         &self.resolver
     }
 
+    /// Switches the timing of the cycle's stages on (times from zero) or off (the default).
+    pub fn set_stage_timing(&mut self, on: bool) {
+        self.clock.set(on);
+    }
+
+    /// Time spent per stage since [`Controller::set_stage_timing`] switched timing on; `None`
+    /// when it is off.
+    pub fn stage_times(&self) -> Option<&StageTimes> {
+        self.clock.times()
+    }
+
     /// One control cycle. Always returns commands that are safe to send.
     pub fn update(&mut self, input: &ControllerInput) -> &ControllerOutput {
         match self.run(input) {
@@ -352,8 +367,11 @@ impl Controller {
         self.check_state(input)?;
         self.check_rest(input)?;
         let first = !std::mem::replace(&mut self.started, true);
+        self.clock.start();
         self.live.collect(input.cells);
+        self.clock.lap(Stage::Skin);
         update_kinematics(&self.config.model, &mut self.data, input.q, input.qd).map_err(stage("kinematics"))?;
+        self.clock.lap(Stage::Dynamics);
 
         // 1. signals and arrangement
         let signals = self.signals()?;
@@ -379,6 +397,7 @@ impl Controller {
         let mut hand = self.hand_signals();
         hand.force_reference = self.hand_force_reference;
         self.output.hand_moment = data.frame_pose(self.ee).rotation.inverse_transform_vector(&hand.moment_world);
+        self.clock.lap(Stage::Skin);
 
         // 3. tasks in priority order, posture, hierarchy
         let cx = Cycle {
@@ -404,6 +423,7 @@ impl Controller {
             }
         }
         let has_posture = self.tasks.posture_torque(order, &cx, &self.locked).map_err(stage("posture torque"))?;
+        self.clock.lap(Stage::Tasks);
         let tasks = &self.tasks;
         let posture = has_posture.then(|| tasks.posture().as_slice());
         let active = order.iter().filter(|&&i| tasks.is_level(i)).map(|&i| &tasks.levels[i]);
@@ -413,7 +433,9 @@ impl Controller {
         }
         match self.config.setup.hierarchy_dynamics {
             HierarchyDynamics::Model => {
-                self.solver.solve_model(model, &mut self.data, active, posture, true, &mut self.tau_k)
+                self.solver.model_dynamics(model, &mut self.data, true).map_err(stage("hierarchy"))?;
+                self.clock.lap(Stage::Dynamics);
+                self.solver.solve_with_model(active, posture, true, &mut self.tau_k)
             }
             HierarchyDynamics::Admittance => {
                 self.resolver.virtual_dynamics(input.q, input.qd, input.dt_s, &mut self.mass, &mut self.bias);
@@ -424,6 +446,7 @@ impl Controller {
                     self.mass[(j, j)] = 1.0;
                 }
                 self.bias += &self.gravity;
+                self.clock.lap(Stage::Dynamics);
                 self.solver.solve(&self.mass, active, posture, Some(self.bias.as_slice()), &mut self.tau_k)
             }
         }
@@ -439,11 +462,14 @@ impl Controller {
         };
         self.output.mode = arrangement.mode;
         self.output.torque_norm = self.tau.norm();
+        self.clock.lap(Stage::Hierarchy);
 
         // 5. admittance resolver
         self.resolver
             .update(self.tau.as_slice(), self.gravity.as_slice(), input.q, input.qd, input.dt_s)
             .map_err(stage("resolver"))?;
+        self.clock.lap(Stage::Resolver);
+        self.clock.finish();
         Ok(())
     }
 

@@ -8,6 +8,7 @@ mod cycle;
 mod hand_force;
 mod io;
 mod setup;
+mod stages;
 mod task_set;
 
 #[cfg(test)]
@@ -18,3 +19,4 @@ pub use cycle::Controller;
 pub use hand_force::HandForceMap;
 pub use io::{ControllerInput, ControllerOutput, Fault};
 pub use setup::{ControllerConfig, ControllerSetup, HierarchyDynamics, SetupError};
+pub use stages::{Stage, StageTimes};

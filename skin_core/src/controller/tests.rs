@@ -303,3 +303,37 @@ fn the_first_command_starts_from_zero_whatever_the_measured_velocity() {
     assert!(vx.hypot(vy) <= b.max_linear_accel_m_s2 * dt * (1.0 + 1e-12), "{vx} {vy}");
     assert!(wz.abs() <= b.max_angular_accel_rad_s2 * dt * (1.0 + 1e-12));
 }
+
+/// Stage timing: off by default; on, every stage of a cycle is charged, the shares add up to 1,
+/// and the commands are the same as without timing.
+#[test]
+fn stage_timing_charges_every_stage_without_changing_the_commands() {
+    let (mut timed, mut plain) = (controller("tomm"), controller("tomm"));
+    assert!(timed.stage_times().is_none());
+    timed.set_stage_timing(true);
+    let q = timed.config().setup.posture.clone();
+    let nv = q.len();
+    let mut cells = vec![CellReading::default(); timed.config().layout.num_cells()];
+    cells[3] = CellReading::uniform(0.2, 0.8);
+    for k in 0..3 {
+        let input = ControllerInput {
+            t_s: 0.008 * k as f64,
+            dt_s: 0.008,
+            q: &q,
+            qd: &vec![0.01; nv],
+            cells: &cells,
+            scan: &[],
+        };
+        let a = timed.update(&input).commands.joint_velocities.clone();
+        assert_eq!(a, plain.update(&input).commands.joint_velocities);
+    }
+    let times = *timed.stage_times().unwrap();
+    assert_eq!(times.cycles(), 3);
+    for s in Stage::ALL {
+        assert!(times.total_ns(s) > 0, "{} not charged", s.name());
+    }
+    let sum: f64 = Stage::ALL.iter().map(|&s| times.share(s)).sum();
+    assert!((sum - 1.0).abs() < 1e-12, "{sum}");
+    timed.set_stage_timing(false);
+    assert!(timed.stage_times().is_none());
+}

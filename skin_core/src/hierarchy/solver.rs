@@ -551,7 +551,8 @@ impl HierarchySolver {
 
     /// [`HierarchySolver::solve`] with `M` and `C q̇ + g` computed from the model at the state of
     /// the last `model::update_kinematics` on `data` (CRBA and RNEA into the solver's own
-    /// buffers); `include_bias = false` leaves the bias out.
+    /// buffers); `include_bias = false` leaves the bias out. The same as
+    /// [`HierarchySolver::model_dynamics`] followed by [`HierarchySolver::solve_with_model`].
     pub fn solve_model<'a, I>(
         &mut self,
         model: &RobotModel,
@@ -565,24 +566,51 @@ impl HierarchySolver {
         I: IntoIterator<Item = &'a TaskLevel>,
         I::IntoIter: Clone,
     {
+        self.model_dynamics(model, data, include_bias)?;
+        self.solve_with_model(levels, posture, include_bias, tau_out)
+    }
+
+    /// The first half of [`HierarchySolver::solve_model`]: `M` (CRBA) and, with `include_bias`,
+    /// `C q̇ + g` (RNEA) at the state of the last `model::update_kinematics` on `data`, into the
+    /// solver's own buffers, locked joints decoupled ([`HierarchySolver::set_locked_joints`]).
+    pub fn model_dynamics(
+        &mut self,
+        model: &RobotModel,
+        data: &mut ModelData,
+        include_bias: bool,
+    ) -> Result<(), HierarchyError> {
+        let model_error = |e: crate::model::ModelError| HierarchyError::Model { message: e.to_string() };
+        crba(model, data, &mut self.m_model).map_err(model_error)?;
+        if include_bias {
+            bias_forces(model, data, &mut self.bias_model).map_err(model_error)?;
+        }
+        for (j, _) in self.locked.iter().enumerate().filter(|(_, &l)| l) {
+            self.m_model.row_mut(j).fill(0.0);
+            self.m_model.column_mut(j).fill(0.0);
+            self.m_model[(j, j)] = 1.0;
+            self.bias_model[j] = 0.0;
+        }
+        Ok(())
+    }
+
+    /// The second half of [`HierarchySolver::solve_model`]: [`HierarchySolver::solve`] with the
+    /// `M` and `C q̇ + g` of the last [`HierarchySolver::model_dynamics`] (`include_bias` as
+    /// there).
+    pub fn solve_with_model<'a, I>(
+        &mut self,
+        levels: I,
+        posture: Option<&[f64]>,
+        include_bias: bool,
+        tau_out: &mut DVector<f64>,
+    ) -> Result<(), HierarchyError>
+    where
+        I: IntoIterator<Item = &'a TaskLevel>,
+        I::IntoIter: Clone,
+    {
         // moved out for the call (self.solve borrows self mutably); empty matrices do not allocate
-        let mut m = std::mem::replace(&mut self.m_model, DMatrix::zeros(0, 0));
-        let mut bias = std::mem::replace(&mut self.bias_model, DVector::zeros(0));
-        let run = || -> Result<(), HierarchyError> {
-            let model_error = |e: crate::model::ModelError| HierarchyError::Model { message: e.to_string() };
-            crba(model, data, &mut m).map_err(model_error)?;
-            if include_bias {
-                bias_forces(model, data, &mut bias).map_err(model_error)?;
-            }
-            for (j, _) in self.locked.iter().enumerate().filter(|(_, &l)| l) {
-                m.row_mut(j).fill(0.0);
-                m.column_mut(j).fill(0.0);
-                m[(j, j)] = 1.0;
-                bias[j] = 0.0;
-            }
-            self.solve(&m, levels, posture, include_bias.then_some(bias.as_slice()), tau_out)
-        };
-        let result = run();
+        let m = std::mem::replace(&mut self.m_model, DMatrix::zeros(0, 0));
+        let bias = std::mem::replace(&mut self.bias_model, DVector::zeros(0));
+        let result = self.solve(&m, levels, posture, include_bias.then_some(bias.as_slice()), tau_out);
         self.m_model = m;
         self.bias_model = bias;
         result
@@ -681,9 +709,21 @@ fn project_row(nproj_pad: &[f64], row: &[f64], jb: &mut [f64], identity: bool, l
 }
 
 /// Index of the first NaN or infinite entry of `x`. The usual all-finite case is one pass without
-/// a branch per entry (the levels' Jacobians are checked every solve).
+/// a branch per entry (the levels' Jacobians are checked every solve): `v − v` is 0 for a finite
+/// `v` and NaN otherwise, summed in eight independent lanes (vectorized).
 fn first_non_finite(x: &[f64]) -> Option<usize> {
-    if x.iter().fold(true, |ok, v| ok & v.is_finite()) {
+    let mut acc = [0.0; 8];
+    let blocks = x.chunks_exact(8);
+    let tail = blocks.remainder();
+    for b in blocks {
+        for (a, v) in acc.iter_mut().zip(b) {
+            #[allow(clippy::eq_op)] // NaN for NaN and ±∞: the point
+            {
+                *a += v - v;
+            }
+        }
+    }
+    if acc.iter().all(|&a| a == 0.0) && tail.iter().all(|v| v.is_finite()) {
         return None;
     }
     x.iter().position(|v| !v.is_finite())

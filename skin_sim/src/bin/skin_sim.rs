@@ -3,7 +3,8 @@
 //! `skin_sim list` names the scenarios; `skin_sim run <scenario|scene file>` runs one, prints a
 //! summary and writes `metrics.json` and `summary.txt` into `--out`; the exit code is non-zero
 //! when an outcome check fails. `skin_sim sweep` runs the speed/accuracy study and generates
-//! `docs/tradeoffs.md` (`make study`).
+//! `docs/tradeoffs.md` (`make study`); `skin_sim performance` generates `docs/performance.md` from
+//! the benchmark results (`make performance`).
 
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -63,6 +64,19 @@ enum Command {
     /// Run the speed/accuracy study over control rate, timestep, skin density and the inverse's
     /// damping; write results.json and generate the document with its figures.
     Sweep(SweepArgs),
+    /// Generate the performance document (cost curves of `Controller::update` over cells, active
+    /// cells and joints, with their figures) from the benchmark results of `make bench`.
+    Performance {
+        /// The benchmark medians.
+        #[arg(long, default_value = "out/bench/summary.json")]
+        summary: PathBuf,
+        /// The points' sizes and stage shares (written by skin_core's controller benchmarks).
+        #[arg(long, default_value = "out/bench/stages.json")]
+        stages: PathBuf,
+        /// The generated document; its figures go into the directory of the same name beside it.
+        #[arg(long, default_value = "docs/performance.md")]
+        doc: PathBuf,
+    },
     /// Run the randomized scene campaign: scenes varied from a seed, judged for safety and
     /// success; writes results.json, summary.json and docs/robustness.md. Exit code 1 when a
     /// scene has a safety violation.
@@ -228,6 +242,13 @@ fn run(args: Command) -> anyhow::Result<bool> {
         }
         Command::Sweep(args) => return sweep(args),
         Command::Campaign(args) => return campaign(args),
+        Command::Performance { summary, stages, doc } => {
+            let series = skin_sim::performance::load(&summary, &stages)?;
+            let files = skin_sim::performance::write(&series, [&summary, &stages], &doc)?;
+            let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
+            println!("wrote {}", names.join(", "));
+            return Ok(true);
+        }
         Command::Run { target, out, controller, duration, control_rate, dt, seed, quiet, video } => {
             (target, out, controller, duration, control_rate, dt, seed, quiet, video)
         }

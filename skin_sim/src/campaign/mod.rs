@@ -16,6 +16,7 @@ use serde::Serialize;
 use serde_json::Value;
 
 use crate::noise::Noise;
+use crate::outputs::FigurePng;
 use crate::report::{write_all, MetricsJson, SummaryText};
 use crate::runner::RunTarget;
 use crate::scenario;
@@ -116,7 +117,7 @@ pub fn run_scene(s: &CampaignScene, out: Option<&Path>) -> SceneResult {
             result.verdict = Some(judge(&report, &limits));
             result.metrics = serde_json::to_value(&report.metrics).ok();
             if let Some(dir) = out {
-                if let Err(e) = write_all(&report, dir, &[&MetricsJson, &SummaryText]) {
+                if let Err(e) = write_all(&report, dir, &[&MetricsJson, &SummaryText, &FigurePng]) {
                     result.error = Some(format!("writing {}: {e}", dir.display()));
                 }
             }

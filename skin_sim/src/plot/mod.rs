@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 // The study's charts (`crate::study::charts`) draw with the same font and colours.
-pub(crate) use draw::{font, FONT, PALETTE};
+pub(crate) use draw::{font, legend, FONT, PALETTE};
 pub use layouts::{
     guidance_figure, paper000_figure, paper003_figure, GuidanceSignals, Paper000Signals, Paper003Signals,
 };

@@ -9,7 +9,7 @@ use plotters::prelude::*;
 use super::analysis::{self, Candidate};
 use super::grid::Axis;
 use super::variant::PointResult;
-use crate::plot::{font, FONT, PALETTE};
+use crate::plot::{font, legend, FONT, PALETTE};
 
 fn err(e: impl std::fmt::Display) -> anyhow::Error {
     anyhow!("{e}")
@@ -118,14 +118,7 @@ pub fn pareto(points: &[&PointResult], path: &Path) -> anyhow::Result<()> {
             Text::new(text, (c.cost, c.error), (FONT, 11).into_font().color(&BLACK.mix(0.8)))
         }))
         .map_err(err)?;
-    chart
-        .configure_series_labels()
-        .label_font((FONT, 12))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.3))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperRight).map_err(err)?;
     root.present().map_err(err)
 }
 

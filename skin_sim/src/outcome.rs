@@ -2,6 +2,7 @@
 //! number and its limit.
 
 use crate::metrics::{Metrics, FORCE_RISE_LIMIT_S, RECOVERY_LIMIT_S};
+use crate::safety;
 use crate::scenario::ForceTargets;
 
 /// One check.
@@ -45,20 +46,15 @@ pub const FIRST_CONTACT_OVERSHOOT_N: f64 = 2.0;
 /// (interactive-force-control paper Exp. 2): no link contact above `ε_c`, the hand at `d_p,d` (when it is not 0) and
 /// moved by the touches on the arm (when there are some).
 pub fn checks(m: &Metrics, targets: Option<ForceTargets>) -> Vec<Check> {
+    let violations = safety::violations(&m.safety, m.faulted_cycles);
     let mut out = vec![Check {
-        name: "no safe-stop cycles",
-        detail: format!("{} faulted cycles", m.faulted_cycles),
-        passed: m.faulted_cycles == 0,
+        name: "safe (no non-finite command, safe-stop, joint over its velocity limit, contact over eps_c > 0.5 s, chatter)",
+        detail: if violations.is_empty() { "none".into() } else { violations.join("; ") },
+        passed: violations.is_empty(),
     }];
     if let Some(g) = &m.goal {
         out.push(at_most("goal reached", g.goal_error_m, g.goal_tolerance_m, "m"));
         out.push(at_most("contact force <= eps_c (outside pushes)", g.max_contact_force_n, g.eps_c_n, "N"));
-        out.push(at_most(
-            "contact above eps_c at most 0.5 s per event (pushes included)",
-            g.longest_contact_over_eps_c_s,
-            RECOVERY_LIMIT_S,
-            "s",
-        ));
         if !g.hard_contact_recovery_s.is_nan() {
             out.push(at_most("hard push relieved", g.hard_contact_recovery_s, RECOVERY_LIMIT_S, "s"));
         }

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use skin_core::controller::ControllerConfig;
+use skin_core::controller::Controller;
 use skin_core::supervisor::{Mode, SupervisorInput};
 
 use crate::closed_loop::{ClosedLoop, LoopError};
@@ -15,6 +15,7 @@ use crate::outcome;
 use crate::probe::ContactProbe;
 use crate::record::{CycleRecord, RunRecord, Switch};
 use crate::report::RunReport;
+use crate::safety::SafetyLimits;
 use crate::scenario::{self, ForceTargets, Scenario};
 use crate::scene::{RunOverrides, Scene};
 use crate::view::ViewRecorder;
@@ -86,7 +87,7 @@ impl RunTarget {
     pub fn run_scene(&self, scene: Scene, progress: impl FnMut(f64)) -> Result<RunReport, LoopError> {
         let duration = scene.spec.duration_s;
         let closed_loop = ClosedLoop::new(scene.clone(), &self.controller)?;
-        let limits = limits_of(closed_loop.controller().config());
+        let limits = limits_of(closed_loop.controller());
         let record = closed_loop.run(duration, progress);
         Ok(self.report(record, &scene, limits))
     }
@@ -94,19 +95,27 @@ impl RunTarget {
     /// The report of `record`, a run of `scene` (named after this target): metrics and checks.
     pub fn report(&self, mut record: RunRecord, scene: &Scene, limits: Limits) -> RunReport {
         record.name = self.name.clone();
-        let metrics = metrics::compute(&record, scene, limits);
+        let metrics = metrics::compute(&record, scene, &limits);
         let checks = outcome::checks(&metrics, self.force_targets);
         RunReport { record, metrics, checks }
     }
 }
 
-/// The supervisor thresholds the metrics compare with.
-fn limits_of(config: &ControllerConfig) -> Limits {
+/// The supervisor thresholds and the arm's URDF velocity limits the metrics compare with.
+fn limits_of(controller: &Controller) -> Limits {
+    let config = controller.config();
     let thresholds = config.supervisor.thresholds;
+    let joint_speed_limits = controller
+        .resolver()
+        .arm_joints()
+        .iter()
+        .filter_map(|&j| Some((j, config.model.joint_limits().get(j)?.velocity)))
+        .collect();
     Limits {
         eps_c_n: thresholds.contact_force_n,
         goal_tolerance_m: thresholds.goal_tolerance_m,
         hand_distance_desired_m: config.tasks.hand_force.distance_desired_m,
+        safety: SafetyLimits { eps_c_n: thresholds.contact_force_n, joint_speed_limits },
     }
 }
 
@@ -160,7 +169,7 @@ impl ExternalRun {
         let config = in_process.controller().config();
         let ee = config.model.frame_index(&config.setup.end_effector).expect("checked by Controller::new");
         Ok(ExternalRun {
-            limits: limits_of(config),
+            limits: limits_of(in_process.controller()),
             probe: ContactProbe::new(world, ee),
             interactions: Interactions::new(&scene, config.tasks.base_avoidance),
             hand: HandForceMap::new(config),
@@ -196,6 +205,7 @@ impl ExternalRun {
             joint_velocities: decision.joint_velocities,
             base_twist: decision.base_twist,
             mode: decision.mode,
+            blocked: false, // not in ControllerState.msg yet
             blend: decision.blend,
             fusion_weight: decision.fusion_weight,
             signals: decision.signals,

@@ -115,6 +115,7 @@ impl Controller {
             commands: resolver.commands().clone(),
             fault: None,
             mode: supervisor.mode(),
+            blocked: None,
             blend: 0.0,
             fusion_weight: config.skin.fusion.weight_force,
             signals: SupervisorInput::default(),
@@ -167,6 +168,9 @@ impl Controller {
             if !finite {
                 return Err(Fault::NonFinite { input: "goal", index: 0 });
             }
+        }
+        if goal != self.goal {
+            self.supervisor.new_goal(); // a push given up toward the old goal may succeed now
         }
         self.goal = goal;
         Ok(())
@@ -225,7 +229,9 @@ impl Controller {
         self.supervisor.impose(a)
     }
 
-    /// The supervisor (mode, arrangement, transition log).
+    /// The supervisor (mode, arrangement, transition log, [`Blocked`] hold).
+    ///
+    /// [`Blocked`]: crate::supervisor::Blocked
     pub fn supervisor(&self) -> &Supervisor {
         &self.supervisor
     }
@@ -410,6 +416,7 @@ impl Controller {
             0.0
         };
         self.output.mode = arrangement.mode;
+        self.output.blocked = self.supervisor.blocked();
         self.output.torque_norm = self.tau.norm();
 
         // 5. admittance resolver

@@ -3,7 +3,7 @@
 
 use crate::metrics::{Metrics, FORCE_RISE_LIMIT_S, RECOVERY_LIMIT_S};
 use crate::safety;
-use crate::scenario::ForceTargets;
+use crate::scene::spec::ExpectSpec;
 
 /// One check.
 #[derive(Debug, Clone, PartialEq)]
@@ -40,12 +40,16 @@ pub const GUIDED_MIN_M: f64 = 0.05;
 /// contact phase starts without an impact.
 pub const FIRST_CONTACT_OVERSHOOT_N: f64 = 2.0;
 
-/// The checks of a run: no faulted cycle; intentional-contact paper scenes: goal reached, every contact at most
-/// `ε_c` outside the pushes, pushes relieved within [`RECOVERY_LIMIT_S`]; interactive-force-control paper scenes with
-/// `targets`: the RMS force errors of Table 3; scenes with neither goals nor force references
-/// (interactive-force-control paper Exp. 2): no link contact above `ε_c`, the hand at `d_p,d` (when it is not 0) and
-/// moved by the touches on the arm (when there are some).
-pub fn checks(m: &Metrics, targets: Option<ForceTargets>) -> Vec<Check> {
+/// The checks of a run. Every run: safe ([`safety::violations`]). What the scene declares
+/// (`expect`; `None`: a scene with goals expects the supervisor's goal tolerance and `ε_c`):
+/// the goal reached, every contact at most `ε_c` outside the pushes and the pushes relieved
+/// within [`RECOVERY_LIMIT_S`], the RMS force errors of Table 3; with `safety`, a run that ends
+/// `blocked` (the push could not succeed) passes on safety alone. Every scene of its kind:
+/// force scenes the first touch, the rise and a finite from-touch RMS; scenes with neither goals
+/// nor force references (interactive-force-control paper Exp. 2) no link contact above `ε_c`,
+/// the hand at `d_p,d` (when it is not 0) and moved by the touches on the arm (when there are
+/// some). A check whose figure is not finite fails.
+pub fn checks(m: &Metrics, expect: Option<&ExpectSpec>) -> Vec<Check> {
     let violations = safety::violations(&m.safety, m.faulted_cycles);
     let mut out = vec![Check {
         name: "safe (no non-finite command, safe-stop, joint over its velocity limit, contact over eps_c > 0.5 s, chatter)",
@@ -53,10 +57,31 @@ pub fn checks(m: &Metrics, targets: Option<ForceTargets>) -> Vec<Check> {
         passed: violations.is_empty(),
     }];
     if let Some(g) = &m.goal {
-        out.push(at_most("goal reached", g.goal_error_m, g.goal_tolerance_m, "m"));
-        out.push(at_most("contact force <= eps_c (outside pushes)", g.max_contact_force_n, g.eps_c_n, "N"));
-        if !g.hard_contact_recovery_s.is_nan() {
-            out.push(at_most("hard push relieved", g.hard_contact_recovery_s, RECOVERY_LIMIT_S, "s"));
+        let defaults = ExpectSpec {
+            goal_tolerance_m: Some(g.goal_tolerance_m),
+            eps_c_n: Some(g.eps_c_n),
+            ..ExpectSpec::default()
+        };
+        let expect = expect.unwrap_or(&defaults);
+        let blocked = g.outcome == "blocked";
+        if expect.safety {
+            out.push(Check {
+                name: "goal reached or blocked (the goal may be unreachable)",
+                detail: g.outcome.to_string(),
+                passed: g.outcome != "not_reached",
+            });
+        }
+        // A blocked run of a scene that may be blocked is judged on safety alone.
+        if !(expect.safety && blocked) {
+            if let Some(tol) = expect.goal_tolerance_m {
+                out.push(at_most("goal reached", g.goal_error_m, tol, "m"));
+            }
+            if let Some(eps) = expect.eps_c_n {
+                out.push(at_most("contact force <= eps_c (outside pushes)", g.max_contact_force_n, eps, "N"));
+                if !g.hard_contact_recovery_s.is_nan() {
+                    out.push(at_most("hard push relieved", g.hard_contact_recovery_s, RECOVERY_LIMIT_S, "s"));
+                }
+            }
         }
     }
     if let Some(c) = &m.contact_free {
@@ -83,7 +108,7 @@ pub fn checks(m: &Metrics, targets: Option<ForceTargets>) -> Vec<Check> {
             passed: f.rms_force_error_from_touch_n.is_finite(),
         });
     }
-    if let (Some(f), Some(t)) = (&m.force, targets) {
+    if let (Some(f), Some(t)) = (&m.force, expect.and_then(|e| e.force_targets)) {
         out.push(at_most(
             "RMS force error w/o interaction (from reaching the reference)",
             f.rms_force_error_from_reach_n,

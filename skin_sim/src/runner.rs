@@ -16,12 +16,13 @@ use crate::probe::ContactProbe;
 use crate::record::{CycleRecord, RunRecord, Switch};
 use crate::report::RunReport;
 use crate::safety::SafetyLimits;
-use crate::scenario::{self, ForceTargets, Scenario};
+use crate::scenario::{self, Scenario};
 use crate::scene::{RunOverrides, Scene};
 use crate::view::ViewRecorder;
 use skin_core::controller::HandForceMap;
 
-/// What to run: a scene, the controller setup for it, the targets it is judged on.
+/// What to run: a scene and the controller setup for it (what it is judged on is in the scene
+/// file's `expect:`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunTarget {
     /// Name in the report (the scenario's, or the scene file's stem).
@@ -30,18 +31,11 @@ pub struct RunTarget {
     pub scene: PathBuf,
     /// Controller setup file.
     pub controller: PathBuf,
-    /// Interactive-force-control paper Table 3 targets, if any.
-    pub force_targets: Option<ForceTargets>,
 }
 
 impl From<&Scenario> for RunTarget {
     fn from(s: &Scenario) -> Self {
-        RunTarget {
-            name: s.name.to_string(),
-            scene: s.scene_file(),
-            controller: s.controller_file(),
-            force_targets: s.force_targets,
-        }
+        RunTarget { name: s.name.to_string(), scene: s.scene_file(), controller: s.controller_file() }
     }
 }
 
@@ -61,7 +55,6 @@ impl RunTarget {
                         format!("{arg} is not a scenario's scene file: give its controller setup with --controller")
                     })?,
                     scene: path,
-                    force_targets: None,
                 },
             },
             (None, false) => {
@@ -96,7 +89,7 @@ impl RunTarget {
     pub fn report(&self, mut record: RunRecord, scene: &Scene, limits: Limits) -> RunReport {
         record.name = self.name.clone();
         let metrics = metrics::compute(&record, scene, &limits);
-        let checks = outcome::checks(&metrics, self.force_targets);
+        let checks = outcome::checks(&metrics, scene.spec.expect.as_ref());
         RunReport { record, metrics, checks }
     }
 }

@@ -7,10 +7,12 @@
 //! `blocked`; the fixed obstacle must end `blocked` after a single (b) -> (c).
 
 use skin_core::supervisor::Mode;
+use skin_sim::outcome;
 use skin_sim::report::RunReport;
 use skin_sim::runner::RunTarget;
 use skin_sim::safety;
 use skin_sim::scenario;
+use skin_sim::scene::spec::ExpectSpec;
 use skin_sim::Scene;
 
 /// Runs the shipped scene changed by `change`.
@@ -19,6 +21,12 @@ fn run_variant(change: impl FnOnce(&mut Scene)) -> RunReport {
     let mut scene = Scene::load(&target.scene).expect("the shipped scene");
     change(&mut scene);
     target.run_scene(scene, |_| {}).expect("the variant runs")
+}
+
+/// The shipped scene's `expect:`.
+fn shipped_expect() -> ExpectSpec {
+    let target = RunTarget::from(scenario::find("intentional_contact").unwrap());
+    Scene::load(&target.scene).unwrap().spec.expect.expect("the shipped scene declares its outcome")
 }
 
 fn outcome(r: &RunReport) -> &'static str {
@@ -56,6 +64,12 @@ fn a_fixed_obstacle_is_pushed_once_then_the_arm_holds_blocked() {
     assert!(after.iter().all(|c| c.link_force_n < eps_c), "contact over eps_c while held");
     let speed = after.iter().map(|c| c.signals.ee_speed_mps).fold(0.0, f64::max);
     assert!(speed < 0.05, "the held arm moves at {speed} m/s");
+    // Judged as the shipped scene declares (goal within 1 cm) it fails; a scene that declares its
+    // goal may be unreachable (`expect: {safety: true, ...}`) passes blocked and safe.
+    assert!(!r.passed(), "the goal is not reached");
+    let unreachable = ExpectSpec { safety: true, ..shipped_expect() };
+    let checks = outcome::checks(&r.metrics, Some(&unreachable));
+    assert!(checks.iter().all(|c| c.passed), "{checks:?}");
 }
 
 #[test]

@@ -43,8 +43,9 @@ pub const FIRST_CONTACT_OVERSHOOT_N: f64 = 2.0;
 /// The checks of a run. Every run: safe ([`safety::violations`]). What the scene declares
 /// (`expect`; `None`: a scene with goals expects the supervisor's goal tolerance and `ε_c`):
 /// the goal reached, every contact at most `ε_c` outside the pushes and the pushes relieved
-/// within [`RECOVERY_LIMIT_S`], the RMS force errors of Table 3; with `safety`, a run that ends
-/// `blocked` (the push could not succeed) passes on safety alone. Every scene of its kind:
+/// within [`RECOVERY_LIMIT_S`], a peak contact force, the RMS force errors of Table 3; with
+/// `safety`, a run that ends `blocked` (the push could not succeed) passes on safety and the
+/// peak alone. Every scene of its kind:
 /// force scenes the first touch, the rise and a finite from-touch RMS; scenes with neither goals
 /// nor force references (interactive-force-control paper Exp. 2) no link contact above `ε_c`,
 /// the hand at `d_p,d` (when it is not 0) and moved by the touches on the arm (when there are
@@ -71,7 +72,10 @@ pub fn checks(m: &Metrics, expect: Option<&ExpectSpec>) -> Vec<Check> {
                 passed: g.outcome != "not_reached",
             });
         }
-        // A blocked run of a scene that may be blocked is judged on safety alone.
+        if let Some(peak) = expect.max_contact_force_n {
+            out.push(at_most("peak contact force (outside pushes)", g.max_contact_force_n, peak, "N"));
+        }
+        // A blocked run of a scene that may be blocked is judged on safety (and the peak) alone.
         if !(expect.safety && blocked) {
             if let Some(tol) = expect.goal_tolerance_m {
                 out.push(at_most("goal reached", g.goal_error_m, tol, "m"));

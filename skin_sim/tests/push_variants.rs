@@ -98,3 +98,54 @@ fn the_shipped_movable_obstacle_is_still_pushed_to_the_goal() {
     assert_safe("shipped", &r);
     assert_eq!(outcome(&r), "reached");
 }
+
+/// A controller setup in `dir` that is the shipped planar7 one with `contact_reaction` removed
+/// from the three Table I arrangements.
+fn setup_without_contact_reaction(dir: &std::path::Path) -> std::path::PathBuf {
+    let config = scenario::config_dir();
+    let shipped = std::fs::read_to_string(config.join("supervisor.yaml")).unwrap();
+    let mut supervisor = shipped.clone();
+    for (from, to) in [
+        ("avoidance: [avoidance, goal, contact_reaction]", "avoidance: [avoidance, goal]"),
+        ("intentional_contact: [goal, contact_reaction, avoidance]", "intentional_contact: [goal, avoidance]"),
+        ("hard_contact: [contact_reaction, goal, avoidance]", "hard_contact: [goal, avoidance]"),
+    ] {
+        assert!(supervisor.contains(from), "config/supervisor.yaml has `{from}`");
+        supervisor = supervisor.replace(from, to);
+    }
+    std::fs::write(dir.join("supervisor.yaml"), supervisor).unwrap();
+    let setup = std::fs::read_to_string(config.join("controller/planar7.yaml")).unwrap();
+    let anchored = setup.replace(": ../", &format!(": {}/../", config.join("controller").display()));
+    let setup = anchored.replace(
+        &format!("supervisor: {}/../supervisor.yaml", config.join("controller").display()),
+        &format!("supervisor: {}", dir.join("supervisor.yaml").display()),
+    );
+    assert!(setup.contains(&dir.display().to_string()), "the setup names the changed supervisor");
+    let path = dir.join("planar7.yaml");
+    std::fs::write(&path, setup).unwrap();
+    path
+}
+
+/// Done-when of issue 17: removing contact reaction (intentional-contact paper eq. (6)) from
+/// the arrangements makes a check fail. The shipped fixed-obstacle scene declares its peak
+/// contact force (3 eps_c): the contact reaction, first in Table I (c), cuts the failed push's
+/// hard contact short; without it the goal keeps pushing into the fixed obstacle.
+#[test]
+fn removing_contact_reaction_fails_the_fixed_obstacle_scene() {
+    let scene = scenario::config_dir().join("scenes/intentional_contact_fixed_obstacle.yaml");
+    let planar7 = scenario::config_dir().join("controller/planar7.yaml");
+    let with = RunTarget::resolve(scene.to_str().unwrap(), Some(planar7)).unwrap();
+    let report = with.run(&Default::default(), |_| {}).unwrap();
+    for c in &report.checks {
+        assert!(c.passed, "with contact reaction: {}: {}", c.name, c.detail);
+    }
+    assert_eq!(outcome(&report), "blocked");
+
+    let dir = std::env::temp_dir().join(format!("skin_sim_no_reaction_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let without = RunTarget { controller: setup_without_contact_reaction(&dir), ..with };
+    let report = without.run(&Default::default(), |_| {}).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    let failed: Vec<&str> = report.checks.iter().filter(|c| !c.passed).map(|c| c.name).collect();
+    assert_eq!(failed, ["peak contact force (outside pushes)"], "{:?}", report.checks);
+}

@@ -286,6 +286,10 @@ fn check_expect(e: &ExpectSpec, spec: &SceneSpec) -> Checked {
         positive("expect.eps_c_n", f)?;
         needs_goals("eps_c_n")?;
     }
+    if let Some(f) = e.max_contact_force_n {
+        positive("expect.max_contact_force_n", f)?;
+        needs_goals("max_contact_force_n")?;
+    }
     if e.safety {
         needs_goals("safety")?;
     }

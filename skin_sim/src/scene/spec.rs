@@ -74,6 +74,12 @@ pub struct ExpectSpec {
     /// at most this, and every push on an object relieved within 0.5 s \[N\] (needs `goals`).
     #[serde(default)]
     pub eps_c_n: Option<f64>,
+    /// The largest contact force on one link outside the pushes (and 0.5 s after them) must be
+    /// at most this whatever the outcome, a blocked one included: the overshoot of a hard
+    /// contact over `ε_c` that the contact reaction (intentional-contact paper eq. (6), first
+    /// in Table I (c)) must cut short \[N\] (needs `goals`).
+    #[serde(default)]
+    pub max_contact_force_n: Option<f64>,
     /// Interactive-force-control paper Table 3 RMS force errors (needs `force_references`).
     #[serde(default)]
     pub force_targets: Option<ForceTargetsSpec>,

@@ -131,7 +131,7 @@ pub fn violations(safety: &SafetyMetrics, safe_stop_cycles: usize) -> Vec<String
         out.push(format!("{} cycles with a joint over its velocity limit", safety.joint_speed_over_limit_cycles));
     }
     let longest = safety.longest_contact_over_eps_c_s;
-    if !(longest <= CONTACT_EVENT_LIMIT_S) {
+    if longest.is_nan() || longest > CONTACT_EVENT_LIMIT_S {
         out.push(format!("contact over eps_c for {longest:.3} s in one event (limit {CONTACT_EVENT_LIMIT_S} s)"));
     }
     if safety.max_switch_repeats_in_window > CHATTER_MAX_REPEATS {

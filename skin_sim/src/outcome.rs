@@ -123,3 +123,70 @@ pub fn checks(m: &Metrics, expect: Option<&ExpectSpec>) -> Vec<Check> {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::metrics::GoalMetrics;
+    use crate::safety::SafetyMetrics;
+
+    fn goal_run(outcome: &'static str, error_m: f64, peak_n: f64) -> Metrics {
+        Metrics {
+            scenario: "x".into(),
+            realtime_factor: 1.0,
+            sim_duration_s: 20.0,
+            max_joint_speed_rad_s: 0.1,
+            control_cycle_us_p50: 4.0,
+            arrangement_switches: vec![],
+            faulted_cycles: 0,
+            safety: SafetyMetrics {
+                non_finite_command_cycles: 0,
+                joint_speed_over_limit_cycles: 0,
+                longest_contact_over_eps_c_s: 0.01,
+                max_switch_repeats_in_window: 1,
+            },
+            goal: Some(GoalMetrics {
+                goal_reached: outcome == "reached",
+                goal_error_m: error_m,
+                goal_tolerance_m: 0.01,
+                max_contact_force_intentional_n: 3.0,
+                max_contact_force_n: peak_n,
+                eps_c_n: 5.0,
+                hard_contact_recovery_s: f64::NAN,
+                outcome,
+                blocked_at_s: f64::NAN,
+            }),
+            force: None,
+            contact_free: None,
+        }
+    }
+
+    fn failed(m: &Metrics, e: Option<&ExpectSpec>) -> Vec<&'static str> {
+        checks(m, e).into_iter().filter(|c| !c.passed).map(|c| c.name).collect()
+    }
+
+    /// `safety: true` lets a blocked run pass on safety and the declared peak, never a run that
+    /// simply did not get there; without it a blocked run fails its goal.
+    #[test]
+    fn an_unreachable_goal_passes_blocked_and_safe_only() {
+        let declared = ExpectSpec { goal_tolerance_m: Some(0.01), eps_c_n: Some(5.0), ..ExpectSpec::default() };
+        let unreachable = ExpectSpec { safety: true, max_contact_force_n: Some(15.0), ..declared };
+        let blocked = goal_run("blocked", 0.19, 8.1);
+        assert!(failed(&blocked, Some(&unreachable)).is_empty());
+        assert_eq!(failed(&blocked, Some(&declared)), ["goal reached", "contact force <= eps_c (outside pushes)"]);
+        assert_eq!(failed(&blocked, None), failed(&blocked, Some(&declared)), "the defaults are the supervisor's");
+        let stopped = goal_run("not_reached", 0.19, 3.0);
+        assert_eq!(
+            failed(&stopped, Some(&unreachable)),
+            ["goal reached or blocked (the goal may be unreachable)", "goal reached"]
+        );
+        assert_eq!(
+            failed(&goal_run("blocked", 0.19, 46.6), Some(&unreachable)),
+            ["peak contact force (outside pushes)"]
+        );
+        let mut chattering = goal_run("blocked", 0.19, 8.1);
+        chattering.safety.max_switch_repeats_in_window = 3;
+        assert_eq!(failed(&chattering, Some(&unreachable)).len(), 1);
+        assert!(failed(&goal_run("reached", f64::NAN, 1.0), Some(&declared)).contains(&"goal reached"), "NaN fails");
+    }
+}

@@ -181,6 +181,7 @@ impl ClosedLoop {
             joint_velocities: out.commands.joint_velocities.clone(),
             base_twist: out.commands.base_twist,
             mode: out.mode,
+            blocked: out.blocked.is_some(),
             blend: out.blend,
             fusion_weight: out.fusion_weight,
             signals: out.signals,

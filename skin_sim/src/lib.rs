@@ -9,8 +9,9 @@
 //! - [`closed_loop`]: the world and a skin_core `Controller` in lockstep, with the scene's
 //!   [`schedule`] (goals, force references through skin_core's `HandForceMap`, phases), the [`interaction`]
 //!   periods and the physical contact forces of [`probe`], recorded per cycle in [`record`];
-//! - [`scenario`], [`runner`], [`metrics`], [`outcome`], [`report`]: the named scenarios of the
-//!   papers, a run from scene to report, `metrics.json`, the outcome checks, the summary;
+//! - [`scenario`], [`runner`], [`metrics`], [`safety`], [`outcome`], [`report`]: the named
+//!   scenarios of the papers, a run from scene to report, `metrics.json`, the one definition of a
+//!   safe run, the outcome checks, the summary;
 //! - [`plot`]: figures in the papers' style; [`outputs`] (with the `skin_bag` crate's MCAP writer)
 //!   turns a run into `figure.png`, `run.mcap` and the rendered frames of its [`view`] (what
 //!   RViz would show: robot, skin markers, contact arrows);
@@ -39,6 +40,7 @@ mod proximity_rays;
 pub mod record;
 pub mod report;
 pub mod runner;
+pub mod safety;
 pub mod scenario;
 pub mod scene;
 pub mod schedule;

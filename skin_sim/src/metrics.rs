@@ -7,6 +7,7 @@ use skin_core::resolver::BASE_JOINTS;
 use skin_core::supervisor::Mode;
 
 use crate::record::{CycleRecord, RunRecord};
+use crate::safety::{self, SafetyLimits, SafetyMetrics};
 use crate::scene::Scene;
 
 /// An interaction's effect on the force outlasts it: cycles this long after one count as "with
@@ -52,6 +53,9 @@ pub struct Metrics {
     pub arrangement_switches: Vec<SwitchEntry>,
     /// Cycles that were safe-stop steps (a fault of the controller or of its inputs).
     pub faulted_cycles: usize,
+    /// Every scene: the figures of the shared safety definition (`crate::safety`).
+    #[serde(flatten)]
+    pub safety: SafetyMetrics,
     /// Intentional-contact paper figures (scenes with goals).
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub goal: Option<GoalMetrics>,
@@ -107,10 +111,12 @@ pub struct GoalMetrics {
     /// Per push on an object: time from the push's end until the contact force is below `ε_c`
     /// for good (0 if it already is) \[s\]; the largest over the pushes (null: no push).
     pub hard_contact_recovery_s: f64,
-    /// Longest contact event above `ε_c`: the longest run of consecutive cycles with the largest
-    /// link contact force at or over `ε_c`, pushes included (the robot must relieve a hard
-    /// contact, whatever caused it) \[s\].
-    pub longest_contact_over_eps_c_s: f64,
+    /// How the run ended: `reached` (final goal error within the tolerance), `blocked` (the
+    /// supervisor gave up a push that reached `ε_c` and holds the arm in (a): a fixed or too
+    /// heavy obstacle) or `not_reached`.
+    pub outcome: &'static str,
+    /// When the supervisor first held the arm as blocked \[s\] (null: never).
+    pub blocked_at_s: f64,
 }
 
 /// Interactive-force-control paper Table 3: force tracking in the contact phase.
@@ -146,8 +152,8 @@ pub struct ForceMetrics {
     pub contact_lost_fraction: f64,
 }
 
-/// Supervisor thresholds the metrics compare with.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Supervisor thresholds and robot limits the metrics compare with.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Limits {
     /// `ε_c` \[N\].
     pub eps_c_n: f64,
@@ -155,6 +161,8 @@ pub struct Limits {
     pub goal_tolerance_m: f64,
     /// `d_p,d` of the hand distance task \[m\].
     pub hand_distance_desired_m: f64,
+    /// Arm joint velocity limits of the safety figures.
+    pub safety: SafetyLimits,
 }
 
 fn rms(values: impl Iterator<Item = f64>) -> (f64, usize) {
@@ -171,7 +179,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// The metrics of `record`, a run of `scene`.
-pub fn compute(record: &RunRecord, scene: &Scene, limits: Limits) -> Metrics {
+pub fn compute(record: &RunRecord, scene: &Scene, limits: &Limits) -> Metrics {
     let cycles = &record.cycles;
     let arm: Vec<usize> =
         (0..record.joint_names.len()).filter(|&j| !BASE_JOINTS.contains(&record.joint_names[j].as_str())).collect();
@@ -189,6 +197,7 @@ pub fn compute(record: &RunRecord, scene: &Scene, limits: Limits) -> Metrics {
             .map(|s| SwitchEntry { t: s.t_s, from: s.from.name(), to: s.to.name() })
             .collect(),
         faulted_cycles: cycles.iter().filter(|c| c.fault.is_some()).count(),
+        safety: safety::compute(record, &limits.safety),
         goal: (!scene.spec.goals.is_empty()).then(|| goal_metrics(cycles, scene, limits)),
         force: (!scene.spec.force_references.is_empty()).then(|| force_metrics(cycles)),
         contact_free: (scene.spec.goals.is_empty() && scene.spec.force_references.is_empty())
@@ -196,7 +205,7 @@ pub fn compute(record: &RunRecord, scene: &Scene, limits: Limits) -> Metrics {
     }
 }
 
-fn contact_free_metrics(cycles: &[CycleRecord], scene: &Scene, limits: Limits) -> ContactFreeMetrics {
+fn contact_free_metrics(cycles: &[CycleRecord], scene: &Scene, limits: &Limits) -> ContactFreeMetrics {
     let desired = limits.hand_distance_desired_m;
     let range = scene.skin.as_ref().map_or(f64::INFINITY, |s| s.params.proximity.range_m);
     let error = |c: &CycleRecord| c.hand_distance_m.min(range) - desired;
@@ -228,28 +237,7 @@ fn max_link_force(cycles: &[CycleRecord], keep: impl Fn(&CycleRecord) -> bool) -
     cycles.iter().filter(|c| keep(c)).map(|c| c.link_force_n).fold(0.0, f64::max)
 }
 
-/// The longest run of consecutive cycles with the link contact force at or over `limit` \[s\]
-/// (from the first such cycle to the first one below; a run still going at the end counts to the
-/// last cycle).
-pub fn longest_over(cycles: &[CycleRecord], limit: f64) -> f64 {
-    let (mut longest, mut since) = (0.0_f64, None);
-    for c in cycles {
-        match (c.link_force_n >= limit, since) {
-            (true, None) => since = Some(c.t_s),
-            (false, Some(t0)) => {
-                longest = longest.max(c.t_s - t0);
-                since = None;
-            }
-            _ => {}
-        }
-    }
-    if let (Some(t0), Some(last)) = (since, cycles.last()) {
-        longest = longest.max(last.t_s - t0);
-    }
-    longest
-}
-
-fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: Limits) -> GoalMetrics {
+fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: &Limits) -> GoalMetrics {
     let eps = limits.eps_c_n;
     let pushes: Vec<(f64, f64)> =
         scene.spec.pushes.iter().filter(|p| p.object.is_some()).map(|p| (p.start_s, p.end_s)).collect();
@@ -273,7 +261,12 @@ fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: Limits) -> GoalMe
         max_contact_force_n: max_link_force(cycles, |c| !excused(c.t_s)),
         eps_c_n: eps,
         hard_contact_recovery_s: recovery,
-        longest_contact_over_eps_c_s: longest_over(cycles, eps),
+        outcome: match cycles.last() {
+            _ if error <= limits.goal_tolerance_m => "reached",
+            Some(c) if c.blocked => "blocked",
+            _ => "not_reached",
+        },
+        blocked_at_s: cycles.iter().find(|c| c.blocked).map_or(f64::NAN, |c| c.t_s),
     }
 }
 
@@ -357,6 +350,7 @@ mod tests {
             joint_velocities: vec![],
             base_twist: [0.0; 3],
             mode: Mode::Contact,
+            blocked: false,
             blend: 0.0,
             fusion_weight: 1.0,
             signals: SupervisorInput {
@@ -408,7 +402,7 @@ mod tests {
         let forces = [0.0, 6.0, 6.0, 6.0, 1.0, 6.0, 0.0, 6.0, 6.0];
         let cycles: Vec<CycleRecord> =
             forces.iter().enumerate().map(|(k, &f)| cycle(0.1 * k as f64, f, 0.0, false)).collect();
-        assert!((longest_over(&cycles, 5.0) - 0.3).abs() < 1e-9);
-        assert_eq!(longest_over(&cycles[..1], 5.0), 0.0);
+        assert!((safety::longest_over(&cycles, |_| 5.0) - 0.3).abs() < 1e-9);
+        assert_eq!(safety::longest_over(&cycles[..1], |_| 5.0), 0.0);
     }
 }

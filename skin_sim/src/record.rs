@@ -24,6 +24,10 @@ pub struct CycleRecord {
     pub base_twist: [f64; 3],
     /// Active arrangement (intentional-contact paper Table I / interactive-force-control paper Table 1).
     pub mode: Mode,
+    /// The supervisor holds the arm in (a) after a push that reached `ε_c`
+    /// (`skin_core::supervisor::Blocked`); always false when the controller ran elsewhere
+    /// (`ControllerState.msg` does not carry it yet).
+    pub blocked: bool,
     /// `χ` of intentional-contact paper eq. (10)-(11), 0 outside a blend.
     pub blend: f64,
     /// Fusion weight `w(t)` of interactive-force-control paper eq. (6) the skin was fused with.

@@ -45,10 +45,16 @@ impl RunReport {
         if let Some(g) = &m.goal {
             let _ = writeln!(
                 s,
-                "  goal error {:.4} m (reached: {}), max contact force {:.2} N outside pushes, {:.2} N in intentional contact (eps_c {} N), push relieved after {:.3} s",
-                g.goal_error_m, g.goal_reached, g.max_contact_force_n, g.max_contact_force_intentional_n, g.eps_c_n, g.hard_contact_recovery_s
+                "  goal error {:.4} m ({}), max contact force {:.2} N outside pushes, {:.2} N in intentional contact (eps_c {} N), push relieved after {:.3} s",
+                g.goal_error_m, g.outcome, g.max_contact_force_n, g.max_contact_force_intentional_n, g.eps_c_n, g.hard_contact_recovery_s
             );
         }
+        let sf = &m.safety;
+        let _ = writeln!(
+            s,
+            "  safety: longest contact over eps_c {:.3} s, one switch at most {} times in 10 s, {} cycles over a joint velocity limit, {} non-finite commands",
+            sf.longest_contact_over_eps_c_s, sf.max_switch_repeats_in_window, sf.joint_speed_over_limit_cycles, sf.non_finite_command_cycles
+        );
         if let Some(f) = &m.force {
             let _ = writeln!(
                 s,

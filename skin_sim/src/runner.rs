@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use skin_core::controller::ControllerConfig;
+use skin_core::controller::Controller;
 use skin_core::supervisor::{Mode, SupervisorInput};
 
 use crate::closed_loop::{ClosedLoop, LoopError};
@@ -15,12 +15,14 @@ use crate::outcome;
 use crate::probe::ContactProbe;
 use crate::record::{CycleRecord, RunRecord, Switch};
 use crate::report::RunReport;
-use crate::scenario::{self, ForceTargets, Scenario};
+use crate::safety::SafetyLimits;
+use crate::scenario::{self, Scenario};
 use crate::scene::{RunOverrides, Scene};
 use crate::view::ViewRecorder;
 use skin_core::controller::HandForceMap;
 
-/// What to run: a scene, the controller setup for it, the targets it is judged on.
+/// What to run: a scene and the controller setup for it (what it is judged on is in the scene
+/// file's `expect:`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunTarget {
     /// Name in the report (the scenario's, or the scene file's stem).
@@ -29,18 +31,11 @@ pub struct RunTarget {
     pub scene: PathBuf,
     /// Controller setup file.
     pub controller: PathBuf,
-    /// Interactive-force-control paper Table 3 targets, if any.
-    pub force_targets: Option<ForceTargets>,
 }
 
 impl From<&Scenario> for RunTarget {
     fn from(s: &Scenario) -> Self {
-        RunTarget {
-            name: s.name.to_string(),
-            scene: s.scene_file(),
-            controller: s.controller_file(),
-            force_targets: s.force_targets,
-        }
+        RunTarget { name: s.name.to_string(), scene: s.scene_file(), controller: s.controller_file() }
     }
 }
 
@@ -60,7 +55,6 @@ impl RunTarget {
                         format!("{arg} is not a scenario's scene file: give its controller setup with --controller")
                     })?,
                     scene: path,
-                    force_targets: None,
                 },
             },
             (None, false) => {
@@ -86,7 +80,7 @@ impl RunTarget {
     pub fn run_scene(&self, scene: Scene, progress: impl FnMut(f64)) -> Result<RunReport, LoopError> {
         let duration = scene.spec.duration_s;
         let closed_loop = ClosedLoop::new(scene.clone(), &self.controller)?;
-        let limits = limits_of(closed_loop.controller().config());
+        let limits = limits_of(closed_loop.controller());
         let record = closed_loop.run(duration, progress);
         Ok(self.report(record, &scene, limits))
     }
@@ -94,19 +88,27 @@ impl RunTarget {
     /// The report of `record`, a run of `scene` (named after this target): metrics and checks.
     pub fn report(&self, mut record: RunRecord, scene: &Scene, limits: Limits) -> RunReport {
         record.name = self.name.clone();
-        let metrics = metrics::compute(&record, scene, limits);
-        let checks = outcome::checks(&metrics, self.force_targets);
+        let metrics = metrics::compute(&record, scene, &limits);
+        let checks = outcome::checks(&metrics, scene.spec.expect.as_ref());
         RunReport { record, metrics, checks }
     }
 }
 
-/// The supervisor thresholds the metrics compare with.
-fn limits_of(config: &ControllerConfig) -> Limits {
+/// The supervisor thresholds and the arm's URDF velocity limits the metrics compare with.
+fn limits_of(controller: &Controller) -> Limits {
+    let config = controller.config();
     let thresholds = config.supervisor.thresholds;
+    let joint_speed_limits = controller
+        .resolver()
+        .arm_joints()
+        .iter()
+        .filter_map(|&j| Some((j, config.model.joint_limits().get(j)?.velocity)))
+        .collect();
     Limits {
         eps_c_n: thresholds.contact_force_n,
         goal_tolerance_m: thresholds.goal_tolerance_m,
         hand_distance_desired_m: config.tasks.hand_force.distance_desired_m,
+        safety: SafetyLimits { eps_c_n: thresholds.contact_force_n, joint_speed_limits },
     }
 }
 
@@ -160,7 +162,7 @@ impl ExternalRun {
         let config = in_process.controller().config();
         let ee = config.model.frame_index(&config.setup.end_effector).expect("checked by Controller::new");
         Ok(ExternalRun {
-            limits: limits_of(config),
+            limits: limits_of(in_process.controller()),
             probe: ContactProbe::new(world, ee),
             interactions: Interactions::new(&scene, config.tasks.base_avoidance),
             hand: HandForceMap::new(config),
@@ -196,6 +198,7 @@ impl ExternalRun {
             joint_velocities: decision.joint_velocities,
             base_twist: decision.base_twist,
             mode: decision.mode,
+            blocked: false, // not in ControllerState.msg yet
             blend: decision.blend,
             fusion_weight: decision.fusion_weight,
             signals: decision.signals,

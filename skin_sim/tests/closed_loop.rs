@@ -222,12 +222,22 @@ fn unknown_targets_are_refused_with_the_scenario_names() {
     assert!(e.contains("intentional_contact") && e.contains("no_such_scenario"), "{e}");
 }
 
-/// A force scene run under another name (no scenario targets) still checks what every force
-/// scene must show: cut before the hand touches, its from-touch RMS is NaN and the run fails.
+/// A force scene run under another name is checked by what its file declares (`expect:`),
+/// not by the scenario's name: cut before the hand touches, its RMS figures are NaN, and both
+/// the from-touch check of every force scene and the declared Table 3 check fail.
 #[test]
 fn a_renamed_force_scene_that_never_touches_fails() {
     let s = scenario::find("poster_phrc").unwrap();
-    let target = RunTarget { name: "renamed_copy".into(), force_targets: None, ..RunTarget::from(s) };
+    // A copy in a directory of its own, its relative paths anchored at the original's place.
+    let dir = std::env::temp_dir().join(format!("skin_sim_renamed_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scenes = s.scene_file().parent().unwrap().to_path_buf();
+    let text =
+        std::fs::read_to_string(s.scene_file()).unwrap().replace(": ../", &format!(": {}/../", scenes.display()));
+    let copy = dir.join("renamed_copy.yaml");
+    std::fs::write(&copy, text).unwrap();
+    let target = RunTarget::resolve(copy.to_str().unwrap(), Some(s.controller_file())).unwrap();
+    assert!(target.name.starts_with("renamed_copy"), "not the scenario: {}", target.name);
     // the force reference starts at 27 s; the hand touches the wall about 3 s later
     let overrides = RunOverrides { duration_s: Some(28.0), ..RunOverrides::default() };
     let report = target.run(&overrides, |_| {}).unwrap();
@@ -235,5 +245,10 @@ fn a_renamed_force_scene_that_never_touches_fails() {
     assert!(f.rms_force_error_from_touch_n.is_nan(), "{f:?}");
     let failed: Vec<&str> = report.checks.iter().filter(|c| !c.passed).map(|c| c.name).collect();
     assert!(failed.contains(&"force tracked from the touch (finite RMS)"), "{failed:?}");
+    assert!(
+        failed.contains(&"RMS force error w/o interaction (from reaching the reference)"),
+        "the file's Table 3 targets are checked and NaN fails them: {failed:?}"
+    );
     assert!(!report.passed());
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -155,6 +155,17 @@ fn scene_errors_name_the_file_and_the_key() {
     assert!(e.contains("`view.elevation_deg`"), "{e}");
     let e = invalid(&planar7("view: {distance_m: -1}\n"));
     assert!(e.contains("`view.distance_m`"), "{e}");
+    let e = invalid(&planar7("expect: {goal_tolerance_m: 0.01}\n"));
+    assert!(e.contains("`expect.goal_tolerance_m`") && e.contains("no goals"), "{e}");
+    let e = invalid(&planar7("expect: {safety: true}\n"));
+    assert!(e.contains("`expect.safety`"), "{e}");
+    let e = invalid(&planar7("expect: {force_targets: {rms_without_n: 0.2, rms_with_n: 0.5}}\n"));
+    assert!(e.contains("`expect.force_targets`") && e.contains("force_references"), "{e}");
+    let goal = "goals: [{frame: ee, position_m: [1, 0, 0]}]\n";
+    let e = invalid(&planar7(&format!("{goal}expect: {{eps_c_n: .nan}}\n")));
+    assert!(e.contains("`expect.eps_c_n`"), "{e}");
+    let e = invalid(&planar7("expect: {goal: 1}\n"));
+    assert!(e.contains("bad.yaml") && e.contains("goal"), "{e}");
     assert!(matches!(Scene::from_yaml_str("robot: {urdf: x}\n", "bad.yaml", &scenes_dir()), Err(SceneError::Yaml(_))));
     // A valid scene text passes.
     scene(&planar7(""));

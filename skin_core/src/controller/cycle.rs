@@ -144,6 +144,7 @@ impl Controller {
             commands: resolver.commands().clone(),
             fault: None,
             mode: supervisor.mode(),
+            blocked: None,
             blend: 0.0,
             fusion_weight: config.skin.fusion.weight_force,
             signals: SupervisorInput::default(),
@@ -202,6 +203,9 @@ impl Controller {
                 return Err(Fault::NonFinite { input: "goal", index: 0 });
             }
         }
+        if goal != self.goal {
+            self.supervisor.new_goal(); // a push given up toward the old goal may succeed now
+        }
         self.goal = goal;
         Ok(())
     }
@@ -257,7 +261,9 @@ impl Controller {
         self.supervisor.impose(a)
     }
 
-    /// The supervisor (mode, arrangement, transition log).
+    /// The supervisor (mode, arrangement, transition log, [`Blocked`] hold).
+    ///
+    /// [`Blocked`]: crate::supervisor::Blocked
     pub fn supervisor(&self) -> &Supervisor {
         &self.supervisor
     }
@@ -461,6 +467,7 @@ impl Controller {
             0.0
         };
         self.output.mode = arrangement.mode;
+        self.output.blocked = self.supervisor.blocked();
         self.output.torque_norm = self.tau.norm();
         self.clock.lap(Stage::Hierarchy);
 

@@ -4,7 +4,7 @@ use nalgebra::Vector2;
 
 use crate::resolver::Commands;
 use crate::skin::signals::CellReading;
-use crate::supervisor::{Mode, SupervisorInput};
+use crate::supervisor::{Blocked, Mode, SupervisorInput};
 
 /// The measurements of one cycle. Vectors are in model joint order (`RobotModel::joint_names`),
 /// cells in layout order (`ResolvedLayout::cells`).
@@ -70,6 +70,9 @@ pub struct ControllerOutput {
     pub fault: Option<Fault>,
     /// The active arrangement's mode.
     pub mode: Mode,
+    /// Why the arm holds in (a) instead of pushing again: a push in intentional contact reached
+    /// `ε_c` (`None`: not blocked). `ControllerState.msg` does not carry it yet.
+    pub blocked: Option<Blocked>,
     /// `χ` of intentional-contact paper eq. (10)-(11): the weight of the previous arrangement's torque (0: no
     /// blend in progress).
     pub blend: f64,

@@ -4,7 +4,7 @@
 use super::blend::WeightShift;
 use super::log::TransitionLog;
 use super::params::{DwellTimes, FusionShift, ParamError, Policy, SensingRange, SupervisorParams, Thresholds};
-use super::types::{Arrangement, Cause, Imposed, Mode, Phase, PhaseRefused, SupervisorInput, Transition};
+use super::types::{Arrangement, Blocked, Cause, Imposed, Mode, Phase, PhaseRefused, SupervisorInput, Transition};
 
 /// A condition that must hold for a dwell time, with a hysteresis between the condition that
 /// starts the timer (`set`) and the weaker one that keeps it running (`keep`).
@@ -68,6 +68,10 @@ pub struct Supervisor {
     arrangement: Arrangement,
     /// The mode (a) or (b) to return to when a hard contact (c) is released.
     resume: Mode,
+    /// Largest `‖F_c‖` of the current hard contact (c) (NaN counts as infinite).
+    hard_peak_n: f64,
+    /// A push that reached ε_c was given up: (a) holds, no (a) → (b).
+    blocked: Option<Blocked>,
     over_limit: Dwell,
     released: Dwell,
     stuck: Dwell,
@@ -118,6 +122,8 @@ impl Supervisor {
                 fusion_weight_target: w,
             },
             resume: Mode::Avoidance,
+            hard_peak_n: 0.0,
+            blocked: None,
             over_limit: Dwell::IDLE,
             released: Dwell::IDLE,
             stuck: Dwell::IDLE,
@@ -240,6 +246,17 @@ impl Supervisor {
         &self.tasks
     }
 
+    /// Why the arm holds in (a) instead of pushing again (`None`: not blocked).
+    pub fn blocked(&self) -> Option<Blocked> {
+        self.blocked
+    }
+
+    /// The goal changed: a push that was given up may succeed toward the new goal, so the
+    /// [`Blocked`] hold ends.
+    pub fn new_goal(&mut self) {
+        self.blocked = None;
+    }
+
     /// The transition made by the last [`Self::update`], if any.
     pub fn last_transition(&self) -> Option<Transition> {
         self.last_transition
@@ -266,9 +283,20 @@ impl Supervisor {
                 if self.over_limit.step(t, over, over, dw.hard_contact_s) {
                     self.resume = mode;
                     self.switch(t, Mode::HardContact, Cause::ContactOverLimit);
+                    self.hard_peak_n = if fc.is_nan() { f64::INFINITY } else { fc };
                     return;
                 }
                 if mode == Mode::Avoidance {
+                    if let Some(b) = self.blocked {
+                        // Held after a failed push: only a changed situation lets (b) be tried
+                        // again (progress toward the goal, or nothing in range any more).
+                        let clear = fd <= th.obstacle_force_n;
+                        let cleared = self.cleared.step(t, clear, clear, dw.clear_s);
+                        if cleared || ge < b.goal_error_m - th.progress_min_m {
+                            self.blocked = None;
+                        }
+                        return;
+                    }
                     // Stopped: slower than ε_v, or crawling without getting nearer the goal
                     // (a NaN speed is never stopped).
                     let crawl = self.progress.step(t, ge, th.progress_window_s, th.progress_min_m) && !v.is_nan();
@@ -306,8 +334,17 @@ impl Supervisor {
                 }
             }
             Mode::HardContact => {
+                self.hard_peak_n = if fc.is_nan() { f64::INFINITY } else { self.hard_peak_n.max(fc) };
                 if self.released.step(t, below, below, dw.contact_release_s) {
-                    self.switch(t, self.resume, Cause::ContactReleased);
+                    if self.resume == Mode::IntentionalContact {
+                        // The push of (b) reached ε_c: pushing again would only hit ε_c again
+                        // (the (b) <-> (c) cycle of a fixed or too heavy obstacle).
+                        self.blocked =
+                            Some(Blocked { since_s: t, goal_error_m: ge, contact_force_n: self.hard_peak_n });
+                        self.switch(t, Mode::Avoidance, Cause::PushBlocked);
+                    } else {
+                        self.switch(t, self.resume, Cause::ContactReleased);
+                    }
                 }
             }
             // Not reachable under this policy; nothing to do.
@@ -370,6 +407,7 @@ impl Supervisor {
             *d = Dwell::IDLE;
         }
         self.progress = Progress::IDLE;
+        self.hard_peak_n = 0.0;
         let tr = Transition { t_s: t, from, to, cause };
         self.last_transition = Some(tr);
         self.log.push(tr);

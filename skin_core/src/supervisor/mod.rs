@@ -43,4 +43,4 @@ pub use params::{
     ArrangementNames, DwellTimes, FusionShift, ParamError, Policy, SensingRange, SupervisorParams,
     SupervisorParamsError, Thresholds,
 };
-pub use types::{Arrangement, Cause, Imposed, Mode, Phase, PhaseRefused, SupervisorInput, Transition};
+pub use types::{Arrangement, Blocked, Cause, Imposed, Mode, Phase, PhaseRefused, SupervisorInput, Transition};

@@ -115,7 +115,7 @@ fn no_switch_to_b_when_moving_or_clear_or_at_goal() {
 }
 
 #[test]
-fn contact_over_limit_b_to_c_and_release_back_to_b() {
+fn contact_over_limit_in_b_goes_to_c_and_the_push_is_given_up() {
     let p = params();
     let (mut sup, mut t) = in_b(&p);
     let tr = run(&mut sup, &mut t, 10, input(0.0, 0.0, 6.0, 0.2));
@@ -126,13 +126,63 @@ fn contact_over_limit_b_to_c_and_release_back_to_b() {
     assert_eq!(names, ["contact_reaction", "goal", "avoidance"]);
     // Below eps_c but inside the band: stays in (c).
     assert!(run(&mut sup, &mut t, 500, input(0.0, 0.0, 4.0, 0.2)).is_empty());
-    // Below eps_c - band, for the dwell: back to (b).
+    assert_eq!(sup.blocked(), None);
+    // Below eps_c - band, for the dwell: the push of (b) reached eps_c, so back to (a), blocked.
     let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 2.0, 0.2));
     assert_eq!(tr.len(), 1);
-    assert_eq!(
-        (tr[0].from, tr[0].to, tr[0].cause),
-        (Mode::HardContact, Mode::IntentionalContact, Cause::ContactReleased)
-    );
+    assert_eq!((tr[0].from, tr[0].to, tr[0].cause), (Mode::HardContact, Mode::Avoidance, Cause::PushBlocked));
+    let b = sup.blocked().expect("blocked");
+    assert_eq!((b.since_s, b.goal_error_m, b.contact_force_n), (tr[0].t_s, 0.2, 6.0));
+}
+
+/// Against a fixed obstacle the arm is stuck again right after backing off: while blocked the
+/// stuck test is off, so there is no second push (no (b) <-> (c) cycle); a new goal ends it.
+#[test]
+fn blocked_holds_a_until_a_new_goal() {
+    let p = params();
+    let (mut sup, mut t) = in_b(&p);
+    run(&mut sup, &mut t, 10, input(0.0, 3.0, 20.0, 0.2));
+    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
+    assert_eq!(tr.last().map(|tr| tr.cause), Some(Cause::PushBlocked));
+    assert!(run(&mut sup, &mut t, 5000, stuck()).is_empty(), "20 s stuck while blocked: no switch");
+    assert_eq!(sup.blocked().map(|b| b.contact_force_n), Some(20.0));
+    sup.new_goal();
+    assert_eq!(sup.blocked(), None);
+    into_b(&mut sup, &mut t);
+}
+
+/// A hold ends when the situation changed: the goal error fell by `progress_min_m` (the
+/// obstacle gave way) or nothing is in range for `clear_s`; a hard contact while held returns
+/// to the held (a).
+#[test]
+fn blocked_ends_on_goal_progress_or_nothing_in_range() {
+    let p = params();
+    let blocked = || {
+        let (mut sup, mut t) = in_b(&p);
+        run(&mut sup, &mut t, 10, input(0.0, 3.0, 8.0, 0.2));
+        run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
+        assert!(sup.blocked().is_some());
+        (sup, t)
+    };
+    let (mut sup, mut t) = blocked();
+    run(&mut sup, &mut t, 100, input(0.02, 3.0, 0.0, 0.195));
+    assert!(sup.blocked().is_some(), "5 mm of progress is not enough");
+    run(&mut sup, &mut t, 1, input(0.02, 3.0, 0.0, 0.2 - p.thresholds.progress_min_m - 1e-3));
+    assert_eq!(sup.blocked(), None);
+
+    let (mut sup, mut t) = blocked();
+    let steps = (p.dwell.clear_s / DT) as usize;
+    run(&mut sup, &mut t, steps - 2, input(0.0, 0.0, 0.0, 0.3));
+    assert!(sup.blocked().is_some(), "nothing in range for less than clear_s");
+    run(&mut sup, &mut t, 3, input(0.0, 0.0, 0.0, 0.3));
+    assert_eq!(sup.blocked(), None);
+
+    let (mut sup, mut t) = blocked();
+    let tr = run(&mut sup, &mut t, 10, input(0.0, 3.0, 9.0, 0.2));
+    assert_eq!((tr[0].from, tr[0].to), (Mode::Avoidance, Mode::HardContact));
+    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
+    assert_eq!((tr[0].to, tr[0].cause), (Mode::Avoidance, Cause::ContactReleased));
+    assert!(sup.blocked().is_some(), "still held");
 }
 
 #[test]
@@ -394,11 +444,11 @@ fn log_ring_buffer_keeps_latest() {
     p.log_capacity = 2;
     let (mut sup, mut t) = in_b(&p); // a -> b
     run(&mut sup, &mut t, 1, input(0.0, 3.0, 9.0, 0.2)); // b -> c
-    run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2)); // c -> b
+    run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2)); // c -> a (push given up)
     assert_eq!(sup.log().total(), 3);
     let kept: Vec<(Mode, Mode)> = sup.log().iter().map(|t| (t.from, t.to)).collect();
-    assert_eq!(kept, [(Mode::IntentionalContact, Mode::HardContact), (Mode::HardContact, Mode::IntentionalContact)]);
-    assert_eq!(sup.log().last().unwrap().to, Mode::IntentionalContact);
+    assert_eq!(kept, [(Mode::IntentionalContact, Mode::HardContact), (Mode::HardContact, Mode::Avoidance)]);
+    assert_eq!(sup.log().last().unwrap().to, Mode::Avoidance);
 }
 
 // --- blending -------------------------------------------------------------------------------

@@ -98,6 +98,10 @@ pub enum Cause {
     ContactOverLimit,
     /// Contact force back below ε_c − band for the dwell time.
     ContactReleased,
+    /// Contact force back below ε_c − band for the dwell time after a hard contact entered
+    /// from intentional contact (b): the push cannot succeed under ε_c, so the arm goes back to
+    /// (a) (backs off) and intentional contact stays off while [`Blocked`] holds.
+    PushBlocked,
     /// Goal reached during intentional contact.
     GoalReached,
     /// No obstacle in the nominal range any more.
@@ -109,6 +113,21 @@ pub enum Cause {
     /// Decided by another supervisor (the `priority_supervisor` node), see
     /// [`super::Supervisor::impose`].
     Imposed,
+}
+
+/// Why and since when the intentional-contact paper policy holds the arm in (a) instead of
+/// pushing again: a push in intentional contact (b) reached `ε_c` (a fixed obstacle, or one too
+/// heavy to slide under `ε_c`). Cleared by a new goal ([`super::Supervisor::new_goal`]), by goal
+/// progress (the goal error `progress_min_m` below `goal_error_m`) or by nothing in range for
+/// `dwell.clear_s`; until then the stuck test (a) → (b) is off (`docs/supervisor.md`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Blocked {
+    /// When the push was given up (the (c) → (a) switch) \[s\].
+    pub since_s: f64,
+    /// The goal error then \[m\].
+    pub goal_error_m: f64,
+    /// The largest contact force `‖F_c‖` of the hard contact that blocked the push \[N\].
+    pub contact_force_n: f64,
 }
 
 /// An arrangement decided by another supervisor with the same configuration: what

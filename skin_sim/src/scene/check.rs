@@ -1,7 +1,7 @@
 //! Value checks of a scene file that need no robot model: every error names the dotted key.
 
 use super::spec::{
-    BaseMotionSpec, LidarSpec, ObjectSpec, PersonSpec, PushSpec, SceneSpec, ShapeSpec, SkinSpec, ViewSpec,
+    BaseMotionSpec, ExpectSpec, LidarSpec, ObjectSpec, PersonSpec, PushSpec, SceneSpec, ShapeSpec, SkinSpec, ViewSpec,
 };
 
 /// A rejected value: its dotted key (e.g. `objects[2].shape.box.size_m`) and why.
@@ -112,6 +112,9 @@ pub(crate) fn check_values(spec: &SceneSpec) -> Checked {
             }
             None => {}
         }
+    }
+    if let Some(e) = &spec.expect {
+        check_expect(e, spec)?;
     }
     for (i, m) in spec.base_motions.iter().enumerate() {
         check_base_motion(&format!("base_motions[{i}]"), m)?;
@@ -268,4 +271,34 @@ fn check_push(key: &str, p: &PushSpec, objects: &[ObjectSpec]) -> Checked {
         (None, Some(_)) => Ok(()),
         _ => Err(reject(key, "give exactly one of `object` and `link`")),
     }
+}
+
+fn check_expect(e: &ExpectSpec, spec: &SceneSpec) -> Checked {
+    let needs_goals = |key: &str| match spec.goals.is_empty() {
+        true => Err(reject(format!("expect.{key}"), "the scene has no goals")),
+        false => Ok(()),
+    };
+    if let Some(t) = e.goal_tolerance_m {
+        positive("expect.goal_tolerance_m", t)?;
+        needs_goals("goal_tolerance_m")?;
+    }
+    if let Some(f) = e.eps_c_n {
+        positive("expect.eps_c_n", f)?;
+        needs_goals("eps_c_n")?;
+    }
+    if let Some(f) = e.max_contact_force_n {
+        positive("expect.max_contact_force_n", f)?;
+        needs_goals("max_contact_force_n")?;
+    }
+    if e.safety {
+        needs_goals("safety")?;
+    }
+    if let Some(t) = &e.force_targets {
+        positive("expect.force_targets.rms_without_n", t.rms_without_n)?;
+        positive("expect.force_targets.rms_with_n", t.rms_with_n)?;
+        if spec.force_references.is_empty() {
+            return Err(reject("expect.force_targets", "the scene has no force_references"));
+        }
+    }
+    Ok(())
 }

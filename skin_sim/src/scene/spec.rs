@@ -55,6 +55,49 @@ pub struct SceneSpec {
     /// How the run is shown: camera and frame rate of the rendered frames and video.
     #[serde(default)]
     pub view: ViewSpec,
+    /// What a run must show (`skin_sim::outcome`; none: the defaults of its kind of scene).
+    #[serde(default)]
+    pub expect: Option<ExpectSpec>,
+}
+
+/// The outcome a run of the scene must show (`expect:`), beside what every run is checked for
+/// (`skin_sim::safety`) and what every scene of its kind must show (a force scene: the first
+/// touch, the rise, a finite from-touch RMS; a scene without goals and force references: no
+/// link presses on anything). Absent: a scene with goals expects the supervisor's goal
+/// tolerance and `ε_c`.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExpectSpec {
+    /// The final goal error must be at most this \[m\] (needs `goals`).
+    #[serde(default)]
+    pub goal_tolerance_m: Option<f64>,
+    /// The largest contact force on one link outside the pushes (and 0.5 s after them) must be
+    /// at most this, and every push on an object relieved within 0.5 s \[N\] (needs `goals`).
+    #[serde(default)]
+    pub eps_c_n: Option<f64>,
+    /// The largest contact force on one link outside the pushes (and 0.5 s after them) must be
+    /// at most this whatever the outcome, a blocked one included: the overshoot of a hard
+    /// contact over `ε_c` that the contact reaction (intentional-contact paper eq. (6), first
+    /// in Table I (c)) must cut short \[N\] (needs `goals`).
+    #[serde(default)]
+    pub max_contact_force_n: Option<f64>,
+    /// Interactive-force-control paper Table 3 RMS force errors (needs `force_references`).
+    #[serde(default)]
+    pub force_targets: Option<ForceTargetsSpec>,
+    /// The goal may be unreachable (a fixed or too heavy obstacle): a run that ends `blocked`
+    /// passes when it is safe; the goal and `eps_c_n` checks then do not apply (needs `goals`).
+    #[serde(default)]
+    pub safety: bool,
+}
+
+/// Interactive-force-control paper Table 3 targets: RMS force-tracking errors \[N\].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForceTargetsSpec {
+    /// Without interactions (`rms_force_error_from_reach_n`).
+    pub rms_without_n: f64,
+    /// During interactions (`rms_force_error_interaction_n`).
+    pub rms_with_n: f64,
 }
 
 /// How a run is shown (`view:`): the camera of the rendered frames (MuJoCo's free camera) and

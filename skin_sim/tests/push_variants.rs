@@ -1,0 +1,153 @@
+//! Issue 17 item 2: a push that cannot succeed ends safely. A family of variants of the
+//! shipped `intentional_contact` scene, generated here (not shipped scene files): the obstacle
+//! fixed, heavier (1-1.5 kg) or too heavy to slide under eps_c (2 and 3 kg: friction 3.9 /
+//! 5.9 N plus the push to start it), or moved by 5-10 cm. Every run must be safe by the shared definition
+//! (`skin_sim::safety::violations`: no non-finite command, safe-stop, joint over its velocity
+//! limit, contact over eps_c for more than 0.5 s in one event, chatter) and end `reached` or
+//! `blocked`; the fixed obstacle must end `blocked` after a single (b) -> (c).
+
+use skin_core::supervisor::Mode;
+use skin_sim::outcome;
+use skin_sim::report::RunReport;
+use skin_sim::runner::RunTarget;
+use skin_sim::safety;
+use skin_sim::scenario;
+use skin_sim::scene::spec::ExpectSpec;
+use skin_sim::Scene;
+
+/// Runs the shipped scene changed by `change`.
+fn run_variant(change: impl FnOnce(&mut Scene)) -> RunReport {
+    let target = RunTarget::from(scenario::find("intentional_contact").expect("the scenario"));
+    let mut scene = Scene::load(&target.scene).expect("the shipped scene");
+    change(&mut scene);
+    target.run_scene(scene, |_| {}).expect("the variant runs")
+}
+
+/// The shipped scene's `expect:`.
+fn shipped_expect() -> ExpectSpec {
+    let target = RunTarget::from(scenario::find("intentional_contact").unwrap());
+    Scene::load(&target.scene).unwrap().spec.expect.expect("the shipped scene declares its outcome")
+}
+
+fn outcome(r: &RunReport) -> &'static str {
+    r.metrics.goal.as_ref().expect("goal metrics").outcome
+}
+
+fn assert_safe(name: &str, r: &RunReport) {
+    let v = safety::violations(&r.metrics.safety, r.metrics.faulted_cycles);
+    assert!(v.is_empty(), "{name}: {v:?}; switches {:?}", r.record.switches);
+    let o = outcome(r);
+    assert!(o == "reached" || o == "blocked", "{name}: outcome {o}");
+}
+
+fn hard_contacts_from_b(r: &RunReport) -> usize {
+    r.record.switches.iter().filter(|s| (s.from, s.to) == (Mode::IntentionalContact, Mode::HardContact)).count()
+}
+
+#[test]
+fn a_fixed_obstacle_is_pushed_once_then_the_arm_holds_blocked() {
+    let r = run_variant(|s| {
+        s.spec.objects[0].mass_kg = None; // welded to the world
+        s.spec.pushes.clear(); // a push needs a movable object
+    });
+    assert_safe("fixed", &r);
+    assert_eq!(outcome(&r), "blocked", "switches {:?}", r.record.switches);
+    assert_eq!(hard_contacts_from_b(&r), 1, "one push, no (b) <-> (c) cycle: {:?}", r.record.switches);
+    let last = r.record.cycles.last().unwrap();
+    assert_eq!(last.mode, Mode::Avoidance, "held in (a)");
+    // Settled: once held (and the blend and back-off of the first second are over), the arm
+    // touches nothing over eps_c and stands still.
+    let held = r.metrics.goal.as_ref().unwrap().blocked_at_s + 1.0;
+    let after: Vec<_> = r.record.cycles.iter().filter(|c| c.t_s >= held).collect();
+    assert!(after.len() > 1000, "held for {} cycles", after.len());
+    let eps_c = r.metrics.goal.as_ref().unwrap().eps_c_n;
+    assert!(after.iter().all(|c| c.link_force_n < eps_c), "contact over eps_c while held");
+    let speed = after.iter().map(|c| c.signals.ee_speed_mps).fold(0.0, f64::max);
+    assert!(speed < 0.05, "the held arm moves at {speed} m/s");
+    // Judged as the shipped scene declares (goal within 1 cm) it fails; a scene that declares its
+    // goal may be unreachable (`expect: {safety: true, ...}`) passes blocked and safe.
+    assert!(!r.passed(), "the goal is not reached");
+    let unreachable = ExpectSpec { safety: true, ..shipped_expect() };
+    let checks = outcome::checks(&r.metrics, Some(&unreachable));
+    assert!(checks.iter().all(|c| c.passed), "{checks:?}");
+}
+
+/// 1-1.5 kg slide under eps_c once moving (friction 2-2.9 N) and 2-3 kg do not; every one ends
+/// safe, with at most one push that reaches eps_c.
+#[test]
+fn heavier_obstacles_end_safely() {
+    for kg in [1.0, 1.5, 2.0, 3.0] {
+        let r = run_variant(|s| s.spec.objects[0].mass_kg = Some(kg));
+        assert_safe(&format!("{kg} kg"), &r);
+        assert!(hard_contacts_from_b(&r) <= 1, "{kg} kg: {:?}", r.record.switches);
+    }
+}
+
+#[test]
+fn a_shifted_obstacle_ends_safely() {
+    for (dx, dy) in [(0.05, 0.0), (-0.05, 0.0), (0.0, 0.05), (0.07, 0.07), (-0.1, 0.0)] {
+        let r = run_variant(|s| {
+            s.spec.objects[0].xyz[0] += dx;
+            s.spec.objects[0].xyz[1] += dy;
+        });
+        assert_safe(&format!("obstacle moved by ({dx}, {dy}) m"), &r);
+    }
+}
+
+#[test]
+fn the_shipped_movable_obstacle_is_still_pushed_to_the_goal() {
+    let r = run_variant(|_| {});
+    assert_safe("shipped", &r);
+    assert_eq!(outcome(&r), "reached");
+}
+
+/// A controller setup in `dir` that is the shipped planar7 one with `contact_reaction` removed
+/// from the three Table I arrangements.
+fn setup_without_contact_reaction(dir: &std::path::Path) -> std::path::PathBuf {
+    let config = scenario::config_dir();
+    let shipped = std::fs::read_to_string(config.join("supervisor.yaml")).unwrap();
+    let mut supervisor = shipped.clone();
+    for (from, to) in [
+        ("avoidance: [avoidance, goal, contact_reaction]", "avoidance: [avoidance, goal]"),
+        ("intentional_contact: [goal, contact_reaction, avoidance]", "intentional_contact: [goal, avoidance]"),
+        ("hard_contact: [contact_reaction, goal, avoidance]", "hard_contact: [goal, avoidance]"),
+    ] {
+        assert!(supervisor.contains(from), "config/supervisor.yaml has `{from}`");
+        supervisor = supervisor.replace(from, to);
+    }
+    std::fs::write(dir.join("supervisor.yaml"), supervisor).unwrap();
+    let setup = std::fs::read_to_string(config.join("controller/planar7.yaml")).unwrap();
+    let anchored = setup.replace(": ../", &format!(": {}/../", config.join("controller").display()));
+    let setup = anchored.replace(
+        &format!("supervisor: {}/../supervisor.yaml", config.join("controller").display()),
+        &format!("supervisor: {}", dir.join("supervisor.yaml").display()),
+    );
+    assert!(setup.contains(&dir.display().to_string()), "the setup names the changed supervisor");
+    let path = dir.join("planar7.yaml");
+    std::fs::write(&path, setup).unwrap();
+    path
+}
+
+/// Done-when of issue 17: removing contact reaction (intentional-contact paper eq. (6)) from
+/// the arrangements makes a check fail. The shipped fixed-obstacle scene declares its peak
+/// contact force (3 eps_c): the contact reaction, first in Table I (c), cuts the failed push's
+/// hard contact short; without it the goal keeps pushing into the fixed obstacle.
+#[test]
+fn removing_contact_reaction_fails_the_fixed_obstacle_scene() {
+    let scene = scenario::config_dir().join("scenes/intentional_contact_fixed_obstacle.yaml");
+    let planar7 = scenario::config_dir().join("controller/planar7.yaml");
+    let with = RunTarget::resolve(scene.to_str().unwrap(), Some(planar7)).unwrap();
+    let report = with.run(&Default::default(), |_| {}).unwrap();
+    for c in &report.checks {
+        assert!(c.passed, "with contact reaction: {}: {}", c.name, c.detail);
+    }
+    assert_eq!(outcome(&report), "blocked");
+
+    let dir = std::env::temp_dir().join(format!("skin_sim_no_reaction_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let without = RunTarget { controller: setup_without_contact_reaction(&dir), ..with };
+    let report = without.run(&Default::default(), |_| {}).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    let failed: Vec<&str> = report.checks.iter().filter(|c| !c.passed).map(|c| c.name).collect();
+    assert_eq!(failed, ["peak contact force (outside pushes)"], "{:?}", report.checks);
+}

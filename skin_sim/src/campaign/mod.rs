@@ -102,19 +102,10 @@ pub fn run_scene(s: &CampaignScene, out: Option<&Path>) -> SceneResult {
     let dir = s.target.scene.parent().unwrap_or(Path::new("."));
     let run = Scene::from_yaml_str(&text, &format!("campaign scene {} ({})", s.id, s.family.name), dir)
         .map_err(|e| e.to_string())
-        .and_then(|scene| {
-            let model = scene.model.clone();
-            s.target.run_scene(scene, |_| {}).map(|r| (r, model)).map_err(|e| e.to_string())
-        });
+        .and_then(|scene| s.target.run_scene(scene, |_| {}).map_err(|e| e.to_string()));
     match run {
-        Ok((report, model)) => {
-            let limits: Vec<f64> = report
-                .record
-                .arm_joints
-                .iter()
-                .map(|n| model.joint_index(n).map_or(f64::INFINITY, |j| model.joint_limits()[j].velocity))
-                .collect();
-            result.verdict = Some(judge(&report, &limits));
+        Ok(report) => {
+            result.verdict = Some(judge(&report));
             result.metrics = serde_json::to_value(&report.metrics).ok();
             if let Some(dir) = out {
                 if let Err(e) = write_all(&report, dir, &[&MetricsJson, &SummaryText, &FigurePng]) {
@@ -240,10 +231,12 @@ pub fn robustness_md(results: &[SceneResult], s: &Summary) -> String {
          reaching over a table (obstacle shifts, masses, friction), force tracking (reference mean\n\
          2-8 N, amplitude, period 2-8 s, board tilt ±10°, base circle radius) and tactile guidance\n\
          (touched link, force, time).\n\n\
-         A safety violation is a non-finite command, a safe-stop cycle, a joint command over its\n\
-         URDF velocity limit, a contact above eps_c for more than 0.5 s in one event, or chatter\n\
-         (3 entries into hard contact within 10 s). A goal scene is feasible when every obstacle\n\
-         slides under eps_c (mu m g < 5 N) and none is fixed.\n\n\
+         A safety violation (`skin_sim::safety`, the definition every scene check uses) is a\n\
+         non-finite command, a safe-stop cycle, an arm joint over its URDF velocity limit, a contact\n\
+         above eps_c (in a force scene's contact phase: above the reference + 2 N) for more than\n\
+         0.5 s in one event, or chatter (one arrangement switch more than twice within 10 s). A goal\n\
+         scene is feasible when every obstacle slides under eps_c (mu m g < 5 N) and none is fixed;\n\
+         an infeasible one may end `blocked` (the arm gave up the push and holds) if it is safe.\n\n\
          | Figure | Value |\n|---|---|\n\
          | scenes | {} |\n| scenes that could not run | {} |\n| scenes with a safety violation | {} |\n\
          | goal success, feasible scenes | {:.1} % |\n| force scenes within Table 3 | {:.1} % |\n\

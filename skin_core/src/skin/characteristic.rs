@@ -44,7 +44,7 @@ declare_params! {
         /// eq. 3 `d_range`).
         pub range_m: f64 => { unit: "m", range: Range::positive(1.0), live: true },
         /// Decay length of the exponential: smaller means more sensitive close to the surface.
-        pub decay_m: f64 => { unit: "m", range: Range::positive(1.0), live: true },
+        pub decay_m: f64 => { unit: "m", range: Range::positive(10.0), live: true },
     }
 }
 

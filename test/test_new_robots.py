@@ -12,6 +12,7 @@ import subprocess
 import time
 
 import pytest
+import yaml
 
 from conftest import binary
 from test_robot_zoo import robots_dir
@@ -32,6 +33,11 @@ ROBOTS = {
     "tiago_fixed": ("tiago_description/robots/tiago.urdf",
                     ["--end-effector", "arm_7_link",
                      "--arm-joints", ",".join(f"arm_{i}_joint" for i in range(1, 8))]),
+    # Two arms, casters and wheels without velocity limits: every joint outside the chosen arm is
+    # held by the controller (locked_joints), so the URDF needs no limits there.
+    "tiago_dual": ("tiago_description/robots/tiago_dual.urdf",
+                   ["--end-effector", "arm_left_7_link",
+                    "--arm-joints", ",".join(f"arm_left_{i}_joint" for i in range(1, 8))]),
 }
 
 
@@ -80,6 +86,9 @@ def test_reach_past_a_movable_obstacle(name, tmp_path):
     assert any(s["to"] == "intentional_contact" for s in metrics["arrangement_switches"]), metrics
     if "--mobile-base" in ROBOTS[name][1]:
         assert base_travel(tmp_path / "run" / "run.mcap", "base_footprint") > 0.05
+    held = yaml.safe_load(controller.read_text()).get("locked_joints", [])
+    moving = set(yaml.safe_load(scene.read_text())["robot"]["joints"])
+    assert not moving & set(held), "a joint the scene moves is held"
 
 
 def test_choices_the_urdf_cannot_satisfy(tmp_path):

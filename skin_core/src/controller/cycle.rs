@@ -137,7 +137,7 @@ impl Controller {
         solver
             .set_locked_joints(&locked)
             .map_err(|error| SetupError::Inverse { file: config.source.clone(), error })?;
-        let resolver = Resolver::new(model, config.resolver.clone())
+        let resolver = Resolver::with_held(model, config.resolver.clone(), &locked)
             .map_err(|error| SetupError::Resolver { file: config.setup.resolver.display().to_string(), error })?;
         let supervisor = Supervisor::new(&config.supervisor, t0_s)?;
         let output = ControllerOutput {

@@ -74,6 +74,8 @@ pub struct Resolver {
     chain_scale: Vec<f64>,
     /// Commanded velocity limit of each arm joint.
     vmax: Vec<f64>,
+    /// Arm joints held still (the setup's `locked_joints`): command 0, no limits needed.
+    held: Vec<bool>,
     /// Scratch: the virtual velocities before the limits.
     target: Vec<f64>,
     /// Cached exact-step coefficients for `arm_dt`.
@@ -91,6 +93,13 @@ impl Resolver {
     /// Builds the resolver for `model`: base joints by name ([`BASE_JOINTS`]), every other moving
     /// joint is an arm joint; velocity and position limits come from the URDF.
     pub fn new(model: &RobotModel, params: ResolverParams) -> Result<Self, ResolverError> {
+        Self::with_held(model, params, &[])
+    }
+
+    /// [`Resolver::new`] with the joints marked in `held` (model order; shorter: the rest free)
+    /// held still: their command is always 0, so a URDF without limits for them (a caster, a
+    /// gripper's passive joint) is accepted.
+    pub fn with_held(model: &RobotModel, params: ResolverParams, held: &[bool]) -> Result<Self, ResolverError> {
         let base = model.planar_base();
         if base.is_none() && BASE_JOINTS.iter().any(|n| model.joint_index(n).is_some()) {
             return Err(ResolverError::Model(format!(
@@ -126,6 +135,7 @@ impl Resolver {
             chain,
             chain_scale: vec![1.0; roots.len()],
             vmax: vec![0.0; na],
+            held: arm_indices.iter().map(|&j| held.get(j).copied().unwrap_or(false)).collect(),
             target: vec![0.0; na],
             arm_dt: f64::NAN,
             base,
@@ -151,19 +161,23 @@ impl Resolver {
         let limits = model.joint_limits();
         let mut joints = self.arm.clone();
         let mut vmax = self.vmax.clone();
-        for (a, vmax) in joints.iter_mut().zip(&mut vmax) {
+        for ((a, vmax), &held) in joints.iter_mut().zip(&mut vmax).zip(&self.held) {
             let name = &model.joint_names()[a.index];
             let lim = &limits[a.index];
+            let o = params.arm.joints.get(name).copied().unwrap_or_default();
+            a.inertia = o.inertia.unwrap_or(params.arm.inertia);
+            a.damping = o.damping.unwrap_or(params.arm.damping);
+            a.amax = o.max_acceleration.unwrap_or(params.arm.max_acceleration);
+            if held {
+                (*vmax, a.lower, a.upper) = (0.0, f64::NEG_INFINITY, f64::INFINITY);
+                continue;
+            }
             if !(lim.velocity.is_finite() && lim.velocity > 0.0) || lim.lower.is_nan() || lim.upper.is_nan() {
                 return Err(ResolverError::Model(format!(
                     "joint `{name}`: URDF velocity limit {} (must be finite and > 0) or position limits [{}, {}]",
                     lim.velocity, lim.lower, lim.upper
                 )));
             }
-            let o = params.arm.joints.get(name).copied().unwrap_or_default();
-            a.inertia = o.inertia.unwrap_or(params.arm.inertia);
-            a.damping = o.damping.unwrap_or(params.arm.damping);
-            a.amax = o.max_acceleration.unwrap_or(params.arm.max_acceleration);
             *vmax = lim.velocity * params.arm.velocity_limit_scale;
             a.lower = lim.lower;
             a.upper = lim.upper;
@@ -260,7 +274,8 @@ impl Resolver {
             let j = a.index;
             let v = cmd[i] + sync * (qd_measured[j] - cmd[i]);
             let f = tau[j] - g_factor * gravity[j];
-            target[i] = finite_or_max(s.e * v + s.phi * f);
+            // a held joint's target is 0, so it does not scale its chain down (its limit is 0)
+            target[i] = if self.held[i] { 0.0 } else { finite_or_max(s.e * v + s.phi * f) };
         }
         scale_chains(target, &self.vmax, &self.chain, &mut self.chain_scale);
         for (i, a) in self.arm.iter().enumerate() {

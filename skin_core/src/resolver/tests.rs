@@ -479,3 +479,24 @@ fn virtual_dynamics_predict_what_the_resolver_executes() {
         assert!((acc - a[j]).abs() < 0.015 * a[j].abs() + 1e-6, "base {k}: {acc} != {}", a[j]);
     }
 }
+
+#[test]
+fn a_held_joint_needs_no_limits_and_stays_at_zero() {
+    let text = std::fs::read_to_string(root().join("urdf/planar7.urdf")).unwrap();
+    // the first joint without a velocity limit (a caster, a passive joint)
+    let text = text.replacen(r#"velocity="2""#, r#"velocity="0""#, 1);
+    let m = RobotModel::from_urdf_str(&text, "planar7 without a limit").unwrap();
+    let params = ResolverParams::default();
+    let e = Resolver::new(&m, params.clone()).unwrap_err().to_string();
+    assert!(e.contains(&m.joint_names()[0]) && e.contains("velocity limit"), "{e}");
+    let mut held = vec![false; m.nv()];
+    held[0] = true;
+    let mut r = Resolver::with_held(&m, params, &held).unwrap();
+    let (q, qd) = (vec![0.1; m.nv()], vec![0.0; m.nv()]);
+    for _ in 0..50 {
+        r.update(&vec![5.0; m.nv()], &vec![0.0; m.nv()], &q, &qd, ARM_DT).unwrap();
+    }
+    let v = &r.commands().joint_velocities;
+    assert_eq!(v[0], 0.0, "held");
+    assert!(v[1].abs() > 1e-3, "the free joints move: {v:?}");
+}

@@ -85,6 +85,12 @@ pub fn write_files(
         "# q_post of interactive-force-control paper eq. (18), model joint order: the start configuration."
     );
     let _ = writeln!(c, "posture: {}", list(&placement.q0));
+    // every joint the scene does not move is held by the controller too (no torque, command 0)
+    let held: Vec<&str> = (0..model.nv())
+        .filter(|j| !robot.arm.contains(j) && !robot.base.contains(j))
+        .map(|j| model.joint_names()[j].as_str())
+        .collect();
+    let _ = writeln!(c, "# Joints outside the arm and the base: held still.\nlocked_joints: [{}]", held.join(", "));
     write(&files.controller, &c)?;
 
     let mut s = String::new();

@@ -26,8 +26,11 @@ class Launch:
 
     def __init__(self, env, log, pkg, file, *args):
         self.log = log
+        # SIGINT with its default disposition, as in a terminal: a test run started as a background
+        # job inherits it ignored, and Python (so `ros2 launch`) then never sees Ctrl-C
         self.proc = subprocess.Popen(["ros2", "launch", pkg, file, *args], env=env,
-                                     stdout=open(log, "w"), stderr=subprocess.STDOUT, start_new_session=True)
+                                     stdout=open(log, "w"), stderr=subprocess.STDOUT, start_new_session=True,
+                                     preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
     def output(self):
         return self.log.read_text()

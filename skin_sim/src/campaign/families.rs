@@ -18,14 +18,26 @@ pub struct Family {
     pub scenario: &'static str,
     /// Varies `spec`; returns what was drawn.
     pub vary: fn(&mut Noise, &mut SceneSpec) -> Value,
+    /// The objects between the robot and its goal (those present in a scene): what a push must move.
+    pub obstacles: &'static [&'static str],
 }
 
 /// Every family, in the order scenes cycle through them.
 pub const FAMILIES: [Family; 4] = [
-    Family { name: "planar_contact", scenario: "intentional_contact", vary: planar_contact },
-    Family { name: "tomm_reach", scenario: "tomm_movable_obstacles", vary: tomm_reach },
-    Family { name: "force_tracking", scenario: "force_tracking_base_motion", vary: force_tracking },
-    Family { name: "tactile_guidance", scenario: "tactile_guidance", vary: tactile_guidance },
+    Family {
+        name: "planar_contact",
+        scenario: "intentional_contact",
+        vary: planar_contact,
+        obstacles: &["obstacle", "second_obstacle"],
+    },
+    Family {
+        name: "tomm_reach",
+        scenario: "tomm_movable_obstacles",
+        vary: tomm_reach,
+        obstacles: &["obstacle_path", "obstacle_goal"],
+    },
+    Family { name: "force_tracking", scenario: "force_tracking_base_motion", vary: force_tracking, obstacles: &[] },
+    Family { name: "tactile_guidance", scenario: "tactile_guidance", vary: tactile_guidance, obstacles: &[] },
 ];
 
 /// Whether every movable object of `spec` slides under `eps_c` (Coulomb friction `μ m g`), and

@@ -54,13 +54,7 @@ pub fn scene(seed: u64, id: usize) -> Result<CampaignScene, String> {
     let mut spec: SceneSpec = skin_core::param_file::yaml::parse_str(&text, &file).map_err(|e| e.to_string())?;
     let mut rng = Noise::new(seed, id as u64 + 1);
     let drawn = (family.vary)(&mut rng, &mut spec);
-    let pushed: Vec<&str> = spec
-        .objects
-        .iter()
-        .filter(|o| o.mass_kg.is_some() || o.name.contains("obstacle"))
-        .map(|o| o.name.as_str())
-        .collect();
-    let feasible = !spec.goals.is_empty() && families::feasible(&spec, EPS_C_N, &pushed);
+    let feasible = !spec.goals.is_empty() && families::feasible(&spec, EPS_C_N, family.obstacles);
     Ok(CampaignScene { id, family, drawn, feasible, target, spec })
 }
 

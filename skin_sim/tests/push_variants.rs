@@ -2,16 +2,16 @@
 //! shipped `intentional_contact` scene, generated here (not shipped scene files): the obstacle
 //! fixed, heavier (1-1.5 kg) or too heavy to slide under eps_c (2 and 3 kg: friction 3.9 /
 //! 5.9 N plus the push to start it), or moved by 5-10 cm. Every run must be safe by the shared definition
-//! (`skin_sim::safety::violations`: no non-finite command, safe-stop, joint over its velocity
+//! (`skin_sim::outputs::safety::violations`: no non-finite command, safe-stop, joint over its velocity
 //! limit, contact over eps_c for more than 0.5 s in one event, chatter) and end `reached` or
 //! `blocked`; the fixed obstacle must end `blocked` after a single (b) -> (c).
 
 use skin_core::supervisor::Mode;
-use skin_sim::outcome;
-use skin_sim::report::RunReport;
-use skin_sim::runner::RunTarget;
-use skin_sim::safety;
-use skin_sim::scenario;
+use skin_sim::outputs::outcome;
+use skin_sim::outputs::report::RunReport;
+use skin_sim::outputs::safety;
+use skin_sim::run::runner::RunTarget;
+use skin_sim::run::scenario;
 use skin_sim::scene::spec::ExpectSpec;
 use skin_sim::Scene;
 
@@ -104,7 +104,7 @@ fn the_shipped_movable_obstacle_is_still_pushed_to_the_goal() {
 /// A controller setup in `dir` that is the shipped planar7 one with `contact_reaction` removed
 /// from the three Table I arrangements.
 fn setup_without_contact_reaction(dir: &std::path::Path) -> std::path::PathBuf {
-    let config = scenario::config_dir();
+    let config = skin_sim::scene::config_dir();
     let shipped = std::fs::read_to_string(config.join("supervisor.yaml")).unwrap();
     let mut supervisor = shipped.clone();
     for (from, to) in [
@@ -134,8 +134,8 @@ fn setup_without_contact_reaction(dir: &std::path::Path) -> std::path::PathBuf {
 /// hard contact short; without it the goal keeps pushing into the fixed obstacle.
 #[test]
 fn removing_contact_reaction_fails_the_fixed_obstacle_scene() {
-    let scene = scenario::config_dir().join("scenes/intentional_contact_fixed_obstacle.yaml");
-    let planar7 = scenario::config_dir().join("controller/planar7.yaml");
+    let scene = skin_sim::scene::config_dir().join("scenes/intentional_contact_fixed_obstacle.yaml");
+    let planar7 = skin_sim::scene::config_dir().join("controller/planar7.yaml");
     let with = RunTarget::resolve(scene.to_str().unwrap(), Some(planar7)).unwrap();
     let report = with.run(&Default::default(), |_| {}).unwrap();
     for c in &report.checks {

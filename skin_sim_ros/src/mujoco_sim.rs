@@ -17,8 +17,8 @@
 //!
 //! With `--out DIR` (lockstep) a period also waits for the controller's `/controller/state`
 //! answering it, and the run is recorded as `skin_sim run` records it
-//! ([`skin_sim::runner::ExternalRun`]: the world, the commands, the published state): the same
-//! report, outcome checks and files (`skin_sim::outputs::ALL`) are written at the end.
+//! ([`skin_sim::run::runner::ExternalRun`]: the world, the commands, the published state): the same
+//! report, outcome checks and files (`skin_sim::outputs::artifacts::ALL`) are written at the end.
 use std::cell::RefCell;
 use std::path::PathBuf;
 use std::rc::Rc;
@@ -34,7 +34,7 @@ use r2r::rosgraph_msgs::msg::Clock;
 use r2r::sensor_msgs::msg::{JointState, LaserScan};
 use r2r::skin_msgs::msg::{Arrangement, ControllerState, SkinCellArray};
 use r2r::std_msgs::msg::{Float64, Float64MultiArray};
-use skin_sim::runner::{ExternalRun, RunTarget};
+use skin_sim::run::runner::{ExternalRun, RunTarget};
 
 use skin_control::convert::robot::time_msg;
 use skin_control::nodes::topics::*;
@@ -452,7 +452,7 @@ impl SimHandle {
 fn write_report(r: Recorder, world: &skin_sim::World) -> Result<bool> {
     anyhow::ensure!(r.run.cycles() > 0, "--out {}: no control period was completed", r.dir.display());
     let report = r.run.finish(world);
-    let files = skin_sim::report::write_all(&report, &r.dir, &skin_sim::outputs::ALL)?;
+    let files = skin_sim::outputs::report::write_all(&report, &r.dir, &skin_sim::outputs::artifacts::ALL)?;
     print!("{}", report.summary());
     let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
     println!("  wrote {}", names.join(", "));

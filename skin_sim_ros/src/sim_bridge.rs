@@ -17,7 +17,7 @@ use serde::Serialize;
 use skin_core::skin::layout::ResolvedLayout;
 use skin_core::skin::signals::CellReading;
 use skin_core::supervisor::Mode;
-use skin_sim::runner::Decision;
+use skin_sim::run::runner::Decision;
 use skin_sim::scene::Scene;
 use skin_sim::world::World;
 
@@ -350,8 +350,8 @@ mod tests {
     use skin_control::ros_params::flatten;
     use skin_control::task_controller::{SupervisorSource, TaskController, TaskControllerParams, Trigger};
     use skin_core::controller::ControllerConfig;
-    use skin_sim::closed_loop::ClosedLoop;
-    use skin_sim::runner::RunTarget;
+    use skin_sim::run::closed_loop::ClosedLoop;
+    use skin_sim::run::runner::RunTarget;
 
     /// The event-driven cells: all in the first message, then those that read something or
     /// changed (a cell back to zero once), never an unchanged zero one.

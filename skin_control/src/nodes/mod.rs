@@ -1,8 +1,9 @@
-//! The nodes' wiring (topics, timers, services, parameters), one module per node, so that a
-//! binary runs one node and `skin_stack` composes them all in one process (one r2r node each,
-//! one executor). Each `start` function creates the node's entities and spawns its tasks on a
-//! single-threaded `LocalPool`; the caller spins the node and runs the pool, then calls the
-//! handle's `stop` (final messages, summary) when SIGINT/SIGTERM arrives.
+//! The nodes' ROS wiring (topics, timers, services, parameters), one module per executable, each
+//! beside its work without ROS (docs/ros.md). The nodes that `skin_stack` composes in one process
+//! (one r2r node each, one executor) have a `start` function that creates the node's entities
+//! and spawns its tasks on a single-threaded `LocalPool`; the caller spins the node and runs the
+//! pool, then calls the handle's `stop` (final messages, summary) when SIGINT/SIGTERM arrives.
+//! The standalone ones ([`skin_aggregator`], [`skin_watchdog`]) have a `main`.
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -11,6 +12,8 @@ use anyhow::{Context as _, Result};
 use crate::paths;
 
 pub mod priority_supervisor;
+pub mod skin_aggregator;
+pub mod skin_watchdog;
 pub mod task_controller;
 
 /// Topic names of the graph (docs/ros.md), as they resolve in the root namespace (logs and the

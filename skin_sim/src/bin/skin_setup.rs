@@ -41,7 +41,7 @@ struct Args {
     /// have collision geometry].
     #[arg(long, value_delimiter = ',')]
     skin_links: Vec<String>,
-    /// Cell pitch [m].
+    /// Cell pitch \[m\].
     #[arg(long, default_value_t = 0.04)]
     pitch: f64,
     /// Mesh collision geometry as meshes (`mesh`: cells on the surface, convex hulls in MuJoCo)
@@ -57,7 +57,7 @@ struct Args {
     /// for the others].
     #[arg(long, value_delimiter = ',')]
     initial: Vec<String>,
-    /// Scene duration [s].
+    /// Scene duration \[s\].
     #[arg(long, default_value_t = 30.0)]
     duration: f64,
     /// File name prefix [default: the URDF's file stem].
@@ -102,7 +102,7 @@ fn run(args: Args) -> Result<()> {
         meshes: args.meshes,
         package_path: args.package_path.clone(),
         initial,
-        config_dir: skin_sim::scenario::config_dir(),
+        config_dir: skin_sim::scene::config_dir(),
         duration_s: args.duration,
     };
     let robot = choices.robot()?;

@@ -12,10 +12,10 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use clap::{Parser, Subcommand};
-use skin_sim::outputs::{FigurePng, KeyFrames, RunBag};
-use skin_sim::report::{write_all, MetricsJson, RunOutput, SummaryText};
-use skin_sim::runner::RunTarget;
-use skin_sim::scenario::SCENARIOS;
+use skin_sim::outputs::artifacts::{FigurePng, KeyFrames, RunBag};
+use skin_sim::outputs::report::{write_all, MetricsJson, RunOutput, SummaryText};
+use skin_sim::run::runner::RunTarget;
+use skin_sim::run::scenario::SCENARIOS;
 use skin_sim::scene::RunOverrides;
 use skin_sim::study::{self, StudyResults, StudyScenario};
 
@@ -137,7 +137,7 @@ struct SweepArgs {
     quiet: bool,
 }
 
-/// The products of a run (`skin_sim::outputs::ALL`), the video when asked for.
+/// The products of a run (`skin_sim::outputs::artifacts::ALL`), the video when asked for.
 fn outputs(video: bool) -> Vec<Box<dyn RunOutput>> {
     vec![
         Box::new(MetricsJson),

@@ -20,6 +20,11 @@ use thiserror::Error;
 use check::{reject, Rejected};
 pub use spec::*;
 
+/// The repository's `config/` directory (scenes and controller setups).
+pub fn config_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../config")
+}
+
 /// A scene file that could not be loaded.
 #[derive(Debug, Error)]
 pub enum SceneError {

@@ -6,8 +6,8 @@ use serde::Serialize;
 use skin_core::resolver::BASE_JOINTS;
 use skin_core::supervisor::Mode;
 
-use crate::record::{CycleRecord, RunRecord};
-use crate::safety::{self, SafetyLimits, SafetyMetrics};
+use crate::outputs::record::{CycleRecord, RunRecord};
+use crate::outputs::safety::{self, SafetyLimits, SafetyMetrics};
 use crate::scene::Scene;
 
 /// An interaction's effect on the force outlasts it: cycles this long after one count as "with
@@ -53,7 +53,7 @@ pub struct Metrics {
     pub arrangement_switches: Vec<SwitchEntry>,
     /// Cycles that were safe-stop steps (a fault of the controller or of its inputs).
     pub faulted_cycles: usize,
-    /// Every scene: the figures of the shared safety definition (`crate::safety`).
+    /// Every scene: the figures of the shared safety definition (`crate::outputs::safety`).
     #[serde(flatten)]
     pub safety: SafetyMetrics,
     /// Intentional-contact paper figures (scenes with goals).

@@ -7,10 +7,10 @@ use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
 use nalgebra::{Isometry3, Point3, Vector3};
 
-use crate::frames::FrameRef;
-use crate::mjcf::SENSED_GROUPS;
-use crate::noise::Noise;
 use crate::scene::Scene;
+use crate::world::frames::FrameRef;
+use crate::world::mjcf::SENSED_GROUPS;
+use crate::world::noise::Noise;
 use skin_core::resolver::BASE_JOINTS;
 
 /// Noise stream of the LIDAR (see [`Noise::new`]).

@@ -193,7 +193,7 @@ mod tests {
 
     #[test]
     fn base_links_collapse_into_odom_to_base_link() {
-        let model = RobotModel::from_urdf_file(&crate::scenario::config_dir().join("../urdf/tomm.urdf")).unwrap();
+        let model = RobotModel::from_urdf_file(&crate::scene::config_dir().join("../urdf/tomm.urdf")).unwrap();
         let (frames, parents) = tf_tree(&model);
         let name = |k: usize| model.frame_names()[frames[k]].as_str();
         let parent = |link: &str| {
@@ -211,7 +211,7 @@ mod tests {
                 assert!(hops <= frames.len(), "{} is in a cycle", name(k));
             }
         }
-        let planar = RobotModel::from_urdf_file(&crate::scenario::config_dir().join("../urdf/planar7.urdf")).unwrap();
+        let planar = RobotModel::from_urdf_file(&crate::scene::config_dir().join("../urdf/planar7.urdf")).unwrap();
         let (frames, parents) = tf_tree(&planar);
         let name = |k: usize| planar.frame_names()[frames[k]].as_str();
         let of = |link: &str| parents[(0..frames.len()).find(|&k| name(k) == link).unwrap()].map_or(ODOM_FRAME, name);

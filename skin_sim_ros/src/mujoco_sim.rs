@@ -37,11 +37,11 @@ use r2r::std_msgs::msg::{Float64, Float64MultiArray};
 use skin_sim::run::runner::{ExternalRun, RunTarget};
 
 use skin_control::convert::robot::time_msg;
-use skin_control::nodes::topics::*;
 use skin_control::nodes::{local, Pass};
 use skin_control::qos;
 use skin_control::task_controller::ArmsParams;
 use skin_control::tf::{FrameTransform, TfPublisher, BASE_FRAME, ODOM_FRAME, WORLD_FRAME};
+use skin_control::topics::*;
 
 use crate::sim_bridge::{decision, AppliedCommand, SimBridge, SimMessages};
 
@@ -129,7 +129,7 @@ pub fn describe(scene: &str, setup: Option<PathBuf>) -> Result<serde_json::Value
         "urdf": absolute(&setup.urdf.map_or_else(|| scene_dir.join(&loaded.spec.robot.urdf), |u| dir.join(u))),
         "layout": absolute(&dir.join(&setup.skin_layout)),
         "lidar": loaded.spec.lidar.is_some(),
-        "base": skin_control::convert::robot::base_joints(&loaded.model).is_some(),
+        "base": loaded.model.planar_base().is_some(),
         "arms": {"namespaces": arms.namespaces, "joint_prefixes": arms.joint_prefixes},
     }))
 }
@@ -345,7 +345,7 @@ impl SimHandle {
         Ok(())
     }
 
-    /// Wall time since the run started \[s\] (0 before it).
+    /// Wall time since the run started [s] (0 before it).
     fn run_wall_s(&self) -> f64 {
         self.running.map_or(0.0, |r| r.elapsed().as_secs_f64())
     }

@@ -14,10 +14,10 @@ use r2r::skin_msgs::srv::SetPhase;
 use r2r::ParameterValue;
 use skin_core::controller::ControllerConfig;
 
-use super::topics::*;
 use super::{file_setting, resolve, ros_now};
-use crate::qos;
 use crate::priority_supervisor::PrioritySupervisor;
+use crate::qos;
+use crate::topics::*;
 
 /// Node name.
 pub const NODE: &str = "priority_supervisor";

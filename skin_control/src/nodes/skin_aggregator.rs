@@ -3,19 +3,20 @@
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+use crate::aggregator::Aggregator;
+use crate::convert::{patch_frame_id, IssueKind};
+use crate::nodes::{self, file_setting, resolve};
+use crate::ros_params::StructParams;
+use crate::tf::{FrameTransform, TfPublisher};
+use crate::timing::Timing;
+use crate::topics::{CELLS as CELLS_TOPIC, MARKERS as MARKERS_TOPIC, PATCHES as PATCHES_TOPIC};
+use crate::{markers, qos, shutdown};
 use anyhow::{Context as _, Result};
 use clap::Parser;
 use futures::{executor::LocalPool, task::LocalSpawnExt, StreamExt};
 use r2r::skin_msgs::msg::PatchWrenchArray;
 use r2r::visualization_msgs::msg::MarkerArray;
 use r2r::{ParameterValue, RosParams};
-use crate::aggregator::Aggregator;
-use crate::convert::{patch_frame_id, IssueKind};
-use crate::nodes::topics::{CELLS as CELLS_TOPIC, MARKERS as MARKERS_TOPIC, PATCHES as PATCHES_TOPIC};
-use crate::nodes::{self, file_setting, resolve};
-use crate::ros_params::StructParams;
-use crate::tf::{FrameTransform, TfPublisher};
-use crate::{markers, qos, shutdown};
 use skin_core::model::RobotModel;
 use skin_core::param_file::declare::Declared;
 use skin_core::skin::layout::{ResolvedLayout, SkinLayout};
@@ -79,29 +80,6 @@ fn setup(node: &r2r::Node, args: Args) -> Result<Setup> {
     Ok(Setup { layout, params })
 }
 
-/// Durations of one stage over all messages, for the shutdown summary.
-#[derive(Default)]
-struct Timing {
-    count: u64,
-    total: Duration,
-    max: Duration,
-}
-
-impl Timing {
-    fn add(&mut self, d: Duration) {
-        self.count += 1;
-        self.total += d;
-        self.max = self.max.max(d);
-    }
-}
-
-impl std::fmt::Display for Timing {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let mean = self.total.checked_div(self.count.max(1) as u32).unwrap_or_default();
-        write!(f, "mean {mean:?}, max {:?}", self.max)
-    }
-}
-
 /// Runs `skin_aggregator` until SIGINT/SIGTERM: its command line parsed here, then its topics wired to
 /// [`crate::aggregator`].
 pub fn main() -> Result<()> {
@@ -119,7 +97,7 @@ pub fn main() -> Result<()> {
         node.make_derived_parameter_handler(served).context("declaring the parameters")?;
     // Read from the serialized bytes (convert::cdr_cells: no C message per message).
     let mut cells =
-        node.subscribe_raw(nodes::local(CELLS_TOPIC), nodes::topics::CELLS_TYPE, qos::sensor_input(1000))?;
+        node.subscribe_raw(nodes::local(CELLS_TOPIC), crate::topics::CELLS_TYPE, qos::sensor_input(1000))?;
     let patches_pub = node.create_publisher::<PatchWrenchArray>(nodes::local(PATCHES_TOPIC), qos::stream())?;
     let markers_pub = node.create_publisher::<MarkerArray>(nodes::local(MARKERS_TOPIC), qos::stream())?;
     // The patch frames {p_j} that /skin/patches is expressed in, fixed in their links.
@@ -135,7 +113,7 @@ pub fn main() -> Result<()> {
                 })
                 .collect();
             tf.send_static(&frames, &r2r::builtin_interfaces::msg::Time::default())
-                .context(nodes::topics::TF_STATIC)?;
+                .context(crate::topics::TF_STATIC)?;
             Some(tf)
         }
         Err(why) => {

@@ -3,17 +3,17 @@
 //! controller code), started beside the controller; see docs/reliability.md.
 use std::time::{Duration, Instant};
 
+use crate::heartbeat::CommandType;
+use crate::nodes::{local, ros_now};
+use crate::tf::BASE_FRAME;
+use crate::topics::{CMD_VEL, WATCHDOG};
+use crate::watchdog::{Verdict, Watchdog};
+use crate::{heartbeat, nodes, qos, shutdown};
 use anyhow::{Context as _, Result};
 use clap::Parser;
 use futures::{FutureExt as _, StreamExt as _};
 use r2r::geometry_msgs::msg::{Twist, TwistStamped};
 use r2r::std_msgs::msg::{Float64MultiArray, Header};
-use crate::heartbeat::CommandType;
-use crate::nodes::topics::{CMD_VEL, WATCHDOG};
-use crate::nodes::{local, ros_now};
-use crate::tf::BASE_FRAME;
-use crate::watchdog::{Verdict, Watchdog};
-use crate::{heartbeat, nodes, qos, shutdown};
 
 /// Watches /controller/heartbeat (sent by task_controller with every period's commands). When it
 /// has been silent for longer than --timeout-s (the controller crashed, was killed, hangs, or its
@@ -51,11 +51,11 @@ struct Args {
     /// they are needed).
     #[arg(long)]
     learn_topics: bool,
-    /// Heartbeat silence that trips \[s\] (default: 1.5 periods of the controller's 125 Hz, so the
+    /// Heartbeat silence that trips [s] (default: 1.5 periods of the controller's 125 Hz, so the
     /// zeros leave within 2 periods of the last command).
     #[arg(long, value_name = "S", default_value_t = 0.012, value_parser = seconds)]
     timeout_s: f64,
-    /// Period of the repeated zeros while tripped \[s\].
+    /// Period of the repeated zeros while tripped [s].
     #[arg(long, value_name = "S", default_value_t = 0.008, value_parser = seconds)]
     hold_period_s: f64,
 }

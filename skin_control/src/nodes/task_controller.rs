@@ -22,8 +22,7 @@ use skin_core::param_file::declare::{Declared, ParamSpec};
 use skin_core::skin::params::SkinParams;
 use skin_core::tasks::params::TaskParams;
 
-use super::topics::*;
-use super::{file_setting, local, resolve, resolved, ros_now, OnceLog, Timing};
+use super::{file_setting, local, resolve, resolved, ros_now, OnceLog};
 use crate::convert::robot::time_msg;
 use crate::diagnostics::{self, level, Diagnostics, LoopReport};
 use crate::heartbeat::{self, CommandType, Commander};
@@ -35,6 +34,8 @@ use crate::task_controller::{
     Freshness, Idle, InputError, Outputs, TaskController, TaskControllerParams, Trigger, DESCRIPTIONS, START_ONLY,
 };
 use crate::tf::BASE_FRAME;
+use crate::timing::Timing;
+use crate::topics::*;
 use r2r::lifecycle_msgs::msg::{
     State as StateMsg, Transition, Transition as TransitionMsg, TransitionDescription, TransitionEvent,
 };
@@ -145,7 +146,7 @@ struct Shared {
     beat: Header,
     me: Commander,
     command: Command,
-    /// ROS time of the last commands sent \[s\].
+    /// ROS time of the last commands sent [s].
     last_sent_s: Option<f64>,
     /// Periods left of zero commands while taking over ([`TAKE_OVER_PERIODS`]).
     take_over: u32,
@@ -319,7 +320,7 @@ impl Shared {
         }
     }
 
-    /// The node's clock now \[s\].
+    /// The node's clock now [s].
     fn now(&self) -> f64 {
         self.clock.lock().unwrap().get_now().map(|d| d.as_secs_f64()).unwrap_or(0.0)
     }

@@ -18,6 +18,7 @@ use r2r::std_msgs::msg::Float64MultiArray;
 use serde::{Deserialize, Serialize};
 use skin_core::controller::HandForceMap;
 use skin_core::controller::{Controller, ControllerConfig, ControllerInput};
+use skin_core::model::is_base_joint_name;
 use skin_core::model::{frame_pose, update_kinematics, ModelData};
 use skin_core::skin::params::SkinParams;
 use skin_core::supervisor::Mode;
@@ -30,8 +31,8 @@ use crate::convert::control::{
 use crate::convert::robot::{goal_pose, time_s, JointIssue, JointStateIssue, ScanConverter, StateBuffer};
 use crate::convert::{update_cells, CellBuffer, CellMessage, Issue, IssueKind};
 use crate::input_health::{fresh, IssueTable, StampGate, StampIssue};
-use crate::nodes::topics::{ARRANGEMENT, CELLS, FORCE_REFERENCE, GOAL, JOINT_STATES, ODOM, SCAN};
 use crate::tf::{ODOM_FRAME, WORLD_FRAME};
+use crate::topics::{ARRANGEMENT, CELLS, FORCE_REFERENCE, GOAL, JOINT_STATES, ODOM, SCAN};
 
 /// What starts a control cycle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -172,7 +173,7 @@ impl TaskControllerParams {
             control_rate_hz: config.resolver.arm.rate_hz,
             trigger: Trigger::Timer,
             supervisor: SupervisorSource::Topic,
-            use_scan: crate::convert::robot::base_joints(&config.model).is_some(),
+            use_scan: config.model.planar_base().is_some(),
             input_timeout_s: 0.1,
             odom_timeout_s: 0.1,
             cells_timeout_s: 0.1,
@@ -647,7 +648,7 @@ impl TaskController {
     /// The required inputs that have not arrived yet (empty: complete).
     pub fn missing(&self) -> Vec<String> {
         let mut m: Vec<String> =
-            self.state.missing().filter(|n| !self.is_base_joint(n)).map(|n| format!("joint `{n}`")).collect();
+            self.state.missing().filter(|n| !is_base_joint_name(n)).map(|n| format!("joint `{n}`")).collect();
         if self.needs_odom && self.state.odom_time().is_none() {
             m.push("odometry".into());
         }
@@ -658,10 +659,6 @@ impl TaskController {
             m.push("scan".into());
         }
         m
-    }
-
-    fn is_base_joint(&self, name: &str) -> bool {
-        skin_core::resolver::BASE_JOINTS.contains(&name)
     }
 
     /// The required inputs' times \[s\] (joint states: oldest and newest joint) with their topic
@@ -695,7 +692,7 @@ impl TaskController {
                 detail: Some(format!("oldest joint `{name}`")),
             },
             None => {
-                let missing: Vec<&str> = self.state.missing().filter(|n| !self.is_base_joint(n)).collect();
+                let missing: Vec<&str> = self.state.missing().filter(|n| !is_base_joint_name(n)).collect();
                 InputAge {
                     topic: JOINT_STATES,
                     age_s: None,

@@ -15,7 +15,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::Parser;
 use skin_core::mesh::MeshMode;
-use skin_core::resolver::BASE_JOINTS;
+use skin_core::model::BASE_JOINTS;
 use skin_sim::new_robot::base::with_planar_base;
 use skin_sim::new_robot::{pose, write_files, Choices};
 
@@ -41,7 +41,7 @@ struct Args {
     /// have collision geometry].
     #[arg(long, value_delimiter = ',')]
     skin_links: Vec<String>,
-    /// Cell pitch \[m\].
+    /// Cell pitch [m].
     #[arg(long, default_value_t = 0.04)]
     pitch: f64,
     /// Mesh collision geometry as meshes (`mesh`: cells on the surface, convex hulls in MuJoCo)
@@ -57,7 +57,7 @@ struct Args {
     /// for the others].
     #[arg(long, value_delimiter = ',')]
     initial: Vec<String>,
-    /// Scene duration \[s\].
+    /// Scene duration [s].
     #[arg(long, default_value_t = 30.0)]
     duration: f64,
     /// File name prefix [default: the URDF's file stem].

@@ -11,7 +11,6 @@ use crate::scene::Scene;
 use crate::world::frames::FrameRef;
 use crate::world::mjcf::SENSED_GROUPS;
 use crate::world::noise::Noise;
-use skin_core::resolver::BASE_JOINTS;
 
 /// Noise stream of the LIDAR (see [`Noise::new`]).
 const NOISE_STREAM: u64 = 2;
@@ -39,7 +38,7 @@ impl Lidar {
         let model = &scene.model;
         // Scene validation checked both frames.
         let frame = model.frame_index(&spec.frame)?;
-        let base = model.joint_child_frame(model.joint_index(BASE_JOINTS[2])?);
+        let base = model.joint_child_frame(model.planar_base()?[2]);
         let scanner = FrameRef::new(model, mj, frame);
         let base_ref = FrameRef::new(model, mj, base);
         let fov = spec.fov_deg.to_radians();

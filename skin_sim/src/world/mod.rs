@@ -18,7 +18,6 @@ use std::sync::Once;
 
 use mujoco_rs::prelude::*;
 use nalgebra::{Isometry3, Point3, Vector3};
-use skin_core::resolver::BASE_JOINTS;
 use skin_core::skin::markers::SkinMarker;
 use skin_core::skin::signals::CellReading;
 use thiserror::Error;
@@ -184,7 +183,7 @@ impl World {
                 })
             })
             .collect();
-        let arm = (0..model.nv()).filter(|&j| !BASE_JOINTS.contains(&model.joint_names()[j].as_str())).collect();
+        let arm = (0..model.nv()).filter(|&j| !model.is_base_joint(j)).collect();
         let pushes = scene
             .spec
             .pushes
@@ -310,7 +309,7 @@ impl World {
         Ok(())
     }
 
-    /// Commands the base twist `(vx [m/s], vy [m/s], wz [rad/s])` in the BASE frame; ignored when
+    /// Commands the base twist `(vx \[m/s\], vy \[m/s\], wz \[rad/s\])` in the BASE frame; ignored when
     /// the scene freezes the base. Held until the next call; turned into world-frame joint
     /// velocities at every step from the current yaw.
     pub fn set_base_twist(&mut self, twist: [f64; 3]) {

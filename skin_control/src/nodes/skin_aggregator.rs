@@ -64,7 +64,7 @@ fn setup(node: &r2r::Node, args: Args) -> Result<Setup> {
     let model = RobotModel::from_urdf_file(&resolve(&urdf, "urdf_file")?)?;
     let layout = SkinLayout::load(&resolve(&layout_file, "layout_file")?)?.resolve(&model)?;
     let defaults = SkinParams::load(&resolve(&skin_model, "skin_model_file")?)?;
-    let mut params = StructParams::new(defaults, |p| p.validate().map_err(|e| e.to_string()), &[])?
+    let mut params = StructParams::new(defaults, |p| p.validate().map_err(|e| e.to_string()))?
         .with_specs(SkinParams::all_specs())
         .with_read_only("urdf_file", ParameterValue::String(urdf), "Robot URDF (read at start)")
         .with_read_only("layout_file", ParameterValue::String(layout_file), "Skin layout (read at start)")

@@ -1,5 +1,5 @@
-//! The supervisor state machine: intentional-contact paper Table I switched on sensed conditions, or the paper
-//! 003 Table 1 phases switched on request. The exact rules are in `docs/supervisor.md`.
+//! The supervisor state machine: intentional-contact paper Table I switched on sensed conditions, or
+//! interactive-force-control paper Table 1 phases switched on request. The exact rules are in `docs/supervisor.md`.
 
 use super::blend::WeightShift;
 use super::log::TransitionLog;
@@ -90,8 +90,8 @@ pub struct Supervisor {
 }
 
 impl Supervisor {
-    /// A supervisor at time `t0_s` in the initial mode of the policy: (a) avoidance for paper
-    /// 000, precontact for interactive-force-control paper. `t0_s` is the initial switch time.
+    /// A supervisor at time `t0_s` in the initial mode of the policy: (a) avoidance for
+    /// intentional-contact paper, precontact for interactive-force-control paper. `t0_s` is the initial switch time.
     pub fn new(params: &SupervisorParams, t0_s: f64) -> Result<Self, ParamError> {
         params.validate()?;
         let orders = params.task_indices()?;

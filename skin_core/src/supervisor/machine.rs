@@ -298,7 +298,7 @@ impl Supervisor {
                         // way) and the last hard contact of the push is long enough ago that the
                         // (b) → (c) switch cannot repeat more than twice in `retry_interval_s`.
                         let progress = self.push_ref_error_m - ge >= th.progress_min_m;
-                        let spaced = !(t - self.push_limit_s < dw.retry_interval_s);
+                        let spaced = self.retry_spaced(t);
                         self.retry = progress && spaced;
                         self.push_ref_error_m = ge;
                         self.push_limit_s = t;
@@ -315,7 +315,7 @@ impl Supervisor {
                         // a retry, and the arm backing out of range is no changed situation.)
                         let clear = fd <= th.obstacle_force_n;
                         let cleared = self.cleared.step(t, clear, clear, dw.clear_s);
-                        let spaced = !(t - self.push_limit_s < dw.retry_interval_s);
+                        let spaced = self.retry_spaced(t);
                         if spaced && (cleared || ge < b.goal_error_m - th.progress_min_m) {
                             self.blocked = None;
                         }
@@ -416,6 +416,11 @@ impl Supervisor {
         } else {
             (*r + self.range.restore_rate_mps * dt).min(target)
         };
+    }
+
+    /// Whether the last (b) → (c) is at least `retry_interval_s` before `t` (or there was none).
+    fn retry_spaced(&self, t: f64) -> bool {
+        self.push_limit_s.is_nan() || t - self.push_limit_s >= self.dwell.retry_interval_s
     }
 
     fn switch(&mut self, t: f64, to: Mode, cause: Cause) {

@@ -45,14 +45,17 @@ fn hard_contacts_from_b(r: &RunReport) -> usize {
 }
 
 #[test]
-fn a_fixed_obstacle_is_pushed_once_then_the_arm_holds_blocked() {
+fn a_fixed_obstacle_is_pushed_at_most_twice_then_the_arm_holds_blocked() {
     let r = run_variant(|s| {
         s.spec.objects[0].mass_kg = None; // welded to the world
         s.spec.pushes.clear(); // a push needs a movable object
     });
     assert_safe("fixed", &r);
     assert_eq!(outcome(&r), "blocked", "switches {:?}", r.record.switches);
-    assert_eq!(hard_contacts_from_b(&r), 1, "one push, no (b) <-> (c) cycle: {:?}", r.record.switches);
+    // The first push's progress includes its approach, so it may be retried once; a retry
+    // within `retry_interval_s` of a hard contact is never made (docs/supervisor.md).
+    let n = hard_contacts_from_b(&r);
+    assert!((1..=2).contains(&n), "at most two pushes, no (b) <-> (c) cycle: {:?}", r.record.switches);
     let last = r.record.cycles.last().unwrap();
     assert_eq!(last.mode, Mode::Avoidance, "held in (a)");
     // Settled: once held (and the blend and back-off of the first second are over), the arm
@@ -73,13 +76,13 @@ fn a_fixed_obstacle_is_pushed_once_then_the_arm_holds_blocked() {
 }
 
 /// 1-1.5 kg slide under eps_c once moving (friction 2-2.9 N) and 2-3 kg do not; every one ends
-/// safe, with at most one push that reaches eps_c.
+/// safe, with at most two pushes that reach eps_c (a retry of a push that made progress).
 #[test]
 fn heavier_obstacles_end_safely() {
     for kg in [1.0, 1.5, 2.0, 3.0] {
         let r = run_variant(|s| s.spec.objects[0].mass_kg = Some(kg));
         assert_safe(&format!("{kg} kg"), &r);
-        assert!(hard_contacts_from_b(&r) <= 1, "{kg} kg: {:?}", r.record.switches);
+        assert!(hard_contacts_from_b(&r) <= 2, "{kg} kg: {:?}", r.record.switches);
     }
 }
 

@@ -94,6 +94,10 @@ pub struct DwellTimes {
     pub goal_reached_s: f64,
     /// (b) → (a): nothing in range, or invalid (NaN) speed / obstacle / goal inputs.
     pub clear_s: f64,
+    /// [s] a push that reached ε_c but got the goal nearer by `progress_min_m` is tried again,
+    /// (c) → (b), unless the push before it also reached ε_c less than this long ago: at most
+    /// two (b) → (c) in this long, so a retried push never chatters (`docs/supervisor.md`).
+    pub retry_interval_s: f64,
 }
 
 /// The proximity sensing range `d_range` of intentional-contact paper eq. (3) and its ramp (intentional-contact paper Sec. III:
@@ -243,6 +247,7 @@ impl SupervisorParams {
         non_negative(p, "contact_release_s", d.contact_release_s)?;
         non_negative(p, "goal_reached_s", d.goal_reached_s)?;
         non_negative(p, "clear_s", d.clear_s)?;
+        non_negative(p, "retry_interval_s", d.retry_interval_s)?;
 
         let r = &self.sensing_range;
         let p = "sensing_range.";

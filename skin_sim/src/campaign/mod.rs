@@ -164,11 +164,17 @@ pub fn summarize(seed: u64, results: &[SceneResult], wall_s: f64, jobs: usize) -
     }
 }
 
-/// Runs scenes `0..n` of the campaign `seed` on `jobs` threads; `done(finished, result)` after
-/// each.
-pub fn run(seed: u64, n: usize, jobs: usize, mut done: impl FnMut(usize, &SceneResult)) -> (Vec<SceneResult>, Summary) {
+/// Runs scenes `0..n` of the campaign `seed` on `jobs` threads, only those of the family named
+/// `family` if given (the same ids as in the whole campaign); `done(finished, result)` after each.
+pub fn run(
+    seed: u64,
+    n: usize,
+    jobs: usize,
+    family: Option<&str>,
+    mut done: impl FnMut(usize, &SceneResult),
+) -> (Vec<SceneResult>, Summary) {
     let start = Instant::now();
-    let ids: Vec<usize> = (0..n).collect();
+    let ids: Vec<usize> = (0..n).filter(|id| family.is_none_or(|f| FAMILIES[id % FAMILIES.len()].name == f)).collect();
     let mut finished = 0;
     let results = pool::map(
         &ids,
@@ -261,7 +267,7 @@ pub fn robustness_md(results: &[SceneResult], s: &Summary) -> String {
         classes.dedup();
         md += &format!("| {} | {} | {} | {} |\n", f.name, rows.len(), failing.len(), classes.join(", "));
     }
-    md += "\n## Failing scenes\n\nRerun one with `skin_sim campaign --seed <seed> --only <id>` (outputs in `out/campaign/<id>/`).\n\n";
+    md += "\n## Failing scenes\n\nRerun one with `skin_sim campaign --seed <seed> --only <id>` (outputs in `out/campaign/<id>/`), one family with `--family <name>` (the same ids).\n\n";
     let mut any = false;
     for r in results {
         let f = failures(r);

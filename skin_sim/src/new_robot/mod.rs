@@ -221,6 +221,7 @@ impl Choices {
             pitch_m: self.pitch_m,
             faces: Vec::new(),
             spheres: true,
+            caps: true,
             patch_frame: PatchFrame::Link,
             meshes: self.meshes,
             package_path: PackagePath::from_env(&self.package_path),

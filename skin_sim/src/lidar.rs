@@ -1,16 +1,15 @@
 //! Simulated planar LIDAR: a fan of rays in the x-y plane of the scanner's frame, cast against
-//! objects and persons ([`SENSED_GROUPS`], never the robot), reported as 2-D points in the BASE
+//! objects and persons ([`crate::mjcf::SENSED_GROUPS`], never the robot), reported as 2-D points in the BASE
 //! frame (x forward, y left): the closest-obstacle points that base avoidance consumes (interactive-force-control paper
 //! eq. (15)-(17)). Ranges get optional seeded Gaussian noise.
 
-use mujoco_rs::mujoco_c::mjMAXVAL;
 use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use crate::frames::FrameRef;
-use crate::mjcf::SENSED_GROUPS;
 use crate::noise::Noise;
+use crate::proximity_rays::ProximityRays;
 use crate::scene::Scene;
 use skin_core::resolver::BASE_JOINTS;
 
@@ -25,8 +24,8 @@ pub struct Lidar {
     base_from_scanner: Isometry3<f64>,
     /// Unit ray directions in the scanner frame.
     directions: Vec<Vector3<f64>>,
-    /// Scratch: the directions in the world at the scan's pose.
-    world_directions: Vec<[f64; 3]>,
+    /// The sensed geoms, every return read (a return beyond `range_m` still draws its noise).
+    rays: ProximityRays,
     range_m: f64,
     noise_std_m: f64,
     noise: Noise,
@@ -64,7 +63,7 @@ impl Lidar {
         Some(Lidar {
             base_from_scanner: base_ref.placement.inverse() * scanner.placement,
             scanner,
-            world_directions: Vec::with_capacity(spec.rays),
+            rays: ProximityRays::new(mj, f64::INFINITY),
             directions,
             range_m: spec.range_m,
             noise_std_m: spec.noise_std_m,
@@ -85,22 +84,16 @@ impl Lidar {
         &self.ranges
     }
 
-    /// Casts every ray at the data's current kinematics, all at once from the scanner's origin
-    /// (`mj_multiRay`: the distances of `mj_ray`, with each geom's bounding cone computed once
-    /// per scan instead of once per ray).
+    /// Casts every ray at the data's current kinematics, against the sensed geoms only, each
+    /// tested against a shape holding it in the scanner's frame before its ray is cast
+    /// ([`ProximityRays`] with an infinite range: `mj_ray`'s distances).
     pub(crate) fn scan<M: ModelType>(&mut self, data: &mut MjData<M>) {
         let pose = self.scanner.world_pose(data);
-        let origin = pose.translation.vector;
-        self.world_directions.clear();
-        self.world_directions.extend(self.directions.iter().map(|d| -> [f64; 3] { (pose.rotation * d).into() }));
-        // flg_static = true: fixed objects and mocap persons are static bodies and must be seen;
-        // no cutoff: a return beyond range_m still draws its noise.
-        let (hits, dists) =
-            data.multi_ray(&origin.into(), &self.world_directions, Some(&SENSED_GROUPS), true, None, mjMAXVAL, None);
+        self.rays.select_near(data, &pose, Point3::origin(), 0.0);
         self.points.clear();
         for (k, dir) in self.directions.iter().enumerate() {
-            let r = match hits[k] {
-                Some(_) => dists[k] + self.noise.gaussian(self.noise_std_m),
+            let r = match self.rays.cast(data, &pose, Point3::origin(), *dir) {
+                Some(d) => d + self.noise.gaussian(self.noise_std_m),
                 None => f64::INFINITY,
             };
             self.ranges[k] = if r <= self.range_m { r } else { f64::INFINITY };
@@ -115,9 +108,10 @@ impl Lidar {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mjcf::SENSED_GROUPS;
     use crate::World;
 
-    /// The scan of `lidar` as one `mj_ray` per ray, as it was cast before `mj_multiRay`.
+    /// The scan of `lidar` as one `mj_ray` per ray against every geom.
     fn scan_ray_by_ray<M: ModelType>(lidar: &mut Lidar, data: &mut MjData<M>) -> Vec<f64> {
         let pose = lidar.scanner.world_pose(data);
         let origin = pose.translation.vector;
@@ -132,10 +126,10 @@ mod tests {
     }
 
     /// Over the motion of two scenes with a moving base (a board, tables, a wall, persons walking
-    /// up, noise on every return), the batched scan reads every ray's range to the bit as one
+    /// up, noise on every return), the culled scan reads every ray's range to the bit as one
     /// `mj_ray` per ray does, noise included.
     #[test]
-    fn the_batched_scan_reads_what_ray_by_ray_reads() {
+    fn the_culled_scan_reads_what_mj_ray_reads() {
         let mut returns = 0;
         for name in ["tactile_guidance", "poster_phrc"] {
             let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../config/scenes/{name}.yaml"));
@@ -146,12 +140,12 @@ mod tests {
                     world.step();
                 }
                 let mut data = world.mj_data().clone();
-                let mut batched = world.lidar().unwrap().clone();
-                let mut by_ray = batched.clone();
-                batched.scan(&mut data);
+                let mut culled = world.lidar().unwrap().clone();
+                let mut by_ray = culled.clone();
+                culled.scan(&mut data);
                 let expected = scan_ray_by_ray(&mut by_ray, &mut data);
                 let bits = |r: &[f64]| r.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-                assert_eq!(bits(batched.ranges()), bits(&expected), "{name} at {} s", world.time());
+                assert_eq!(bits(culled.ranges()), bits(&expected), "{name} at {} s", world.time());
                 returns += expected.iter().filter(|r| r.is_finite()).count();
             }
         }

@@ -18,7 +18,8 @@
 //! near casts no ray at all (most of TOMM's links, most of the time). The shapes are taken in the
 //! body's frame, so a cell whose segment meets none of them costs no transform to the world.
 //! Every test is conservative (the shapes and segments are [`MARGIN_M`] larger than exact), so
-//! the readings stay those of `mj_ray`.
+//! the readings stay those of `mj_ray`. The LIDAR casts its rays through the same tests with an
+//! infinite range (`crate::lidar`).
 use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::fun::utility::mju_ray_geom;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
@@ -108,7 +109,8 @@ impl Bound {
 }
 
 impl ProximityRays {
-    /// The sensed geoms of `mj` for a sensor that reads nothing from `range_m` on.
+    /// The sensed geoms of `mj` for a sensor that reads nothing from `range_m` on (infinite: a
+    /// sensor that reads every hit, as the LIDAR).
     pub(crate) fn new(mj: &MjModel, range_m: f64) -> Self {
         let (group, kind, matid) = (mj.geom_group(), mj.geom_type(), mj.geom_matid());
         let (geom_rgba, mat_rgba) = (mj.geom_rgba(), mj.mat_rgba());
@@ -213,8 +215,9 @@ fn segment_meets_box(o: Vector3<f64>, d: Vector3<f64>, length: f64, half: Vector
     lo <= hi
 }
 
-/// Whether the end `p + length n` of the segment is not in front of the plane through `origin`
-/// with unit normal `normal` (else the segment cannot cross it from front to back).
+/// Whether the end `p + length n` of the segment (`length` may be infinite) is not in front of
+/// the plane through `origin` with unit normal `normal` (else the segment cannot cross it from
+/// front to back).
 fn segment_end_behind_plane(
     p: Point3<f64>,
     n: Vector3<f64>,
@@ -222,7 +225,12 @@ fn segment_end_behind_plane(
     origin: Point3<f64>,
     normal: Vector3<f64>,
 ) -> bool {
-    (p + n * length - origin).dot(&normal) <= MARGIN_M
+    let (start, along) = ((p - origin).dot(&normal), n.dot(&normal));
+    if along >= 0.0 {
+        start <= MARGIN_M
+    } else {
+        start + length * along <= MARGIN_M
+    }
 }
 
 /// Whether the segment `p + t n`, `0 <= t <= length`, comes within `radius` of `center`.
@@ -294,5 +302,8 @@ mod tests {
         assert!(segment_end_behind_plane(Point3::new(0.0, 0.0, 0.05), down, 0.1, floor, up), "crosses it");
         assert!(!segment_end_behind_plane(Point3::new(0.0, 0.0, 0.15), down, 0.1, floor, up), "ends above it");
         assert!(!segment_end_behind_plane(Point3::new(0.0, 0.0, 0.05), up, 0.1, floor, up), "points away");
+        let (level, inf) = (Vector3::x(), f64::INFINITY);
+        assert!(segment_end_behind_plane(Point3::new(0.0, 0.0, 3.0), down, inf, floor, up), "endless, crosses it");
+        assert!(!segment_end_behind_plane(Point3::new(0.0, 0.0, 0.3), level, inf, floor, up), "endless, level above it");
     }
 }

@@ -3,8 +3,9 @@
 //! `mj_ray` tests every geom of the model for every ray (405 cells of planar7 at 250 Hz: a fifth
 //! of a run's time). A cell's ray can only read a distance below the sensor's `range_m`, so a geom
 //! that the segment `p + t n`, `0 <= t <= range_m`, does not meet cannot change its reading.
-//! [`ProximityRays::cast`] tests the segment against a shape holding each geom (for boxes,
-//! cylinders, capsules and ellipsoids the box of their extents, for spheres the sphere) and calls
+//! [`ProximityRays::cast`] tests the segment against shapes holding each geom (its bounding
+//! sphere `geom_rbound`, then for boxes, cylinders, capsules and ellipsoids the box of their
+//! extents) and calls
 //! `mju_rayGeom` (the function `mj_ray` calls per geom) for the geoms it meets: the same
 //! distances, so the same readings, at a fraction of the cost. Geoms `mj_ray` would skip are
 //! skipped here too: other than [`SENSED_GROUPS`] (the robot never sees itself) or invisible
@@ -46,6 +47,8 @@ pub(crate) enum ProximityRays {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct NearGeom {
     geom: usize,
+    /// The geom's bounding sphere (`geom_rbound`): the first, cheaper test (planes have none).
+    sphere: Option<(Point3<f64>, f64)>,
     bound: Bound,
 }
 
@@ -145,13 +148,21 @@ impl ProximityRays {
             return true;
         };
         let reach = radius + *range_m;
+        let (model, world_centre) = (data.model(), frame * centre);
+        let (kind, rbound, xpos) = (model.geom_type(), model.geom_rbound(), data.geom_xpos());
         near.clear();
-        near.extend(
-            geoms
-                .iter()
-                .map(|&g| NearGeom { geom: g, bound: Bound::of(data, g, frame) })
-                .filter(|ng| ng.bound.within(centre, reach)),
-        );
+        for &g in geoms.iter() {
+            let sphere = (kind[g] != MjtGeomBase::mjGEOM_PLANE).then(|| rbound[g] + MARGIN_M);
+            // the bounding spheres first, in the world: most geoms are far from most bodies
+            if sphere.is_some_and(|r| (world_centre - Point3::from(xpos[g])).norm() > reach + r) {
+                continue;
+            }
+            let bound = Bound::of(data, g, frame);
+            if bound.within(centre, reach) {
+                let sphere = sphere.map(|r| (frame.inverse_transform_point(&Point3::from(xpos[g])), r));
+                near.push(NearGeom { geom: g, sphere, bound });
+            }
+        }
         !near.is_empty()
     }
 
@@ -182,8 +193,10 @@ impl ProximityRays {
         let (xpos, xmat, size, kind) = (data.geom_xpos(), data.geom_xmat(), model.geom_size(), model.geom_type());
         let mut ray = None;
         let mut nearest: Option<f64> = None;
+        let length = range_m + MARGIN_M;
         for ng in near {
-            if !ng.bound.meets_segment(p, n, range_m + MARGIN_M) {
+            let in_sphere = ng.sphere.is_none_or(|(c, r)| segment_meets_sphere(p, n, length, c, r));
+            if !(in_sphere && ng.bound.meets_segment(p, n, length)) {
                 continue;
             }
             let (origin, dir) = ray.get_or_insert_with(world);
@@ -304,6 +317,9 @@ mod tests {
         assert!(!segment_end_behind_plane(Point3::new(0.0, 0.0, 0.05), up, 0.1, floor, up), "points away");
         let (level, inf) = (Vector3::x(), f64::INFINITY);
         assert!(segment_end_behind_plane(Point3::new(0.0, 0.0, 3.0), down, inf, floor, up), "endless, crosses it");
-        assert!(!segment_end_behind_plane(Point3::new(0.0, 0.0, 0.3), level, inf, floor, up), "endless, level above it");
+        assert!(
+            !segment_end_behind_plane(Point3::new(0.0, 0.0, 0.3), level, inf, floor, up),
+            "endless, level above it"
+        );
     }
 }

@@ -17,12 +17,12 @@ use serde::Serialize;
 use skin_core::skin::layout::ResolvedLayout;
 use skin_core::skin::signals::CellReading;
 use skin_core::supervisor::Mode;
-use skin_sim::runner::Decision;
+use skin_sim::run::runner::Decision;
 use skin_sim::scene::Scene;
 use skin_sim::world::World;
 
 use skin_control::convert::control::{read_arm_command, split_arms, supervisor_input, twist_of, ArmCommand};
-use skin_control::convert::robot::{base_joints, time_msg, write_goal, write_joint_state, write_odometry, BaseState};
+use skin_control::convert::robot::{time_msg, write_goal, write_joint_state, write_odometry, BaseState};
 use skin_control::convert::write_cell_array;
 use skin_control::tf::{BASE_FRAME, ODOM_FRAME, WORLD_FRAME};
 
@@ -109,7 +109,7 @@ impl SimBridge {
         let spec = scene.spec.clone();
         let world = World::from_scene(scene).map_err(|e| e.to_string())?;
         let model = &world.scene().model;
-        let base = base_joints(model);
+        let base = model.planar_base();
         let indices: Vec<usize> = (0..model.nv()).filter(|j| !base.is_some_and(|b| b.contains(j))).collect();
         let names = indices.iter().map(|&j| model.joint_names()[j].clone()).collect();
         let arms = split_arms(model.joint_names(), world.arm_joints(), namespaces, prefixes)?;
@@ -260,7 +260,7 @@ impl SimBridge {
 
     /// The base twist command (held until the next one).
     pub fn on_twist(&mut self, msg: &Twist) -> Result<(), String> {
-        self.twist = twist_of(msg).map_err(|e| format!("{}: {e}", skin_control::nodes::topics::CMD_VEL))?;
+        self.twist = twist_of(msg).map_err(|e| format!("{}: {e}", skin_control::topics::CMD_VEL))?;
         Ok(())
     }
 
@@ -350,8 +350,8 @@ mod tests {
     use skin_control::ros_params::flatten;
     use skin_control::task_controller::{SupervisorSource, TaskController, TaskControllerParams, Trigger};
     use skin_core::controller::ControllerConfig;
-    use skin_sim::closed_loop::ClosedLoop;
-    use skin_sim::runner::RunTarget;
+    use skin_sim::run::closed_loop::ClosedLoop;
+    use skin_sim::run::runner::RunTarget;
 
     /// The event-driven cells: all in the first message, then those that read something or
     /// changed (a cell back to zero once), never an unchanged zero one.

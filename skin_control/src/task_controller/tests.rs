@@ -11,7 +11,7 @@ use crate::convert::robot::{time_msg, write_goal};
 use crate::paths;
 
 const RATE_HZ: f64 = 125.0;
-/// config/resolver.yaml `arm.max_acceleration` [rad/s²].
+/// config/resolver.yaml `arm.max_acceleration` \[rad/s²\].
 const AMAX: f64 = 3.0;
 
 /// planar7 on the timer with its own supervisor, a goal away from the start pose.

@@ -58,29 +58,29 @@ impl ArrangementNames {
 pub struct Thresholds {
     /// ε_v [m/s]: the end effector counts as stopped when `‖ẋ‖ ≤ ε_v`.
     pub speed_mps: f64,
-    /// [m/s] a started stuck dwell is kept while `‖ẋ‖ ≤ ε_v + band`.
+    /// \[m/s\] a started stuck dwell is kept while `‖ẋ‖ ≤ ε_v + band`.
     pub speed_band_mps: f64,
     /// ε_c [N]: hard contact when `‖F_c‖ ≥ ε_c`.
     pub contact_force_n: f64,
-    /// [N] hard contact is left only when `‖F_c‖ < ε_c − band`; `0 ≤ band < ε_c`.
+    /// \[N\] hard contact is left only when `‖F_c‖ < ε_c − band`; `0 ≤ band < ε_c`.
     pub contact_band_n: f64,
-    /// [N] nothing in range when `‖F_d‖ ≤` this (0: exactly no repulsion, as in Table I).
+    /// \[N\] nothing in range when `‖F_d‖ ≤` this (0: exactly no repulsion, as in Table I).
     pub obstacle_force_n: f64,
-    /// [N] an obstacle counts as in range for the stuck test when `‖F_d‖ >` threshold + band.
+    /// \[N\] an obstacle counts as in range for the stuck test when `‖F_d‖ >` threshold + band.
     pub obstacle_band_n: f64,
-    /// [m] goal reached when the goal error is `≤` this.
+    /// \[m\] goal reached when the goal error is `≤` this.
     pub goal_tolerance_m: f64,
-    /// [m] the goal counts as not reached for the stuck test when the error is `>` tol + band.
+    /// \[m\] the goal counts as not reached for the stuck test when the error is `>` tol + band.
     pub goal_band_m: f64,
-    /// [s] window of the progress test: moving but not getting nearer the goal (a crawl along an
+    /// \[s\] window of the progress test: moving but not getting nearer the goal (a crawl along an
     /// obstacle faster than ε_v) counts as stopped when the goal error fell by less than
     /// `progress_min_m` over this long.
     pub progress_window_s: f64,
-    /// [m] least fall of the goal error over `progress_window_s` that counts as progress.
+    /// \[m\] least fall of the goal error over `progress_window_s` that counts as progress.
     pub progress_min_m: f64,
 }
 
-/// How long a condition must hold before its switch [s] (all `≥ 0`).
+/// How long a condition must hold before its switch \[s\] (all `≥ 0`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DwellTimes {
@@ -94,6 +94,10 @@ pub struct DwellTimes {
     pub goal_reached_s: f64,
     /// (b) → (a): nothing in range, or invalid (NaN) speed / obstacle / goal inputs.
     pub clear_s: f64,
+    /// [s] a push that reached ε_c but got the goal nearer by `progress_min_m` is tried again,
+    /// (c) → (b), unless the push before it also reached ε_c less than this long ago: at most
+    /// two (b) → (c) in this long, so a retried push never chatters (`docs/supervisor.md`).
+    pub retry_interval_s: f64,
 }
 
 /// The proximity sensing range `d_range` of intentional-contact paper eq. (3) and its ramp (intentional-contact paper Sec. III:
@@ -101,13 +105,13 @@ pub struct DwellTimes {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SensingRange {
-    /// [m] range in (a) and in the interactive-force-control paper phases, `> 0`.
+    /// \[m\] range in (a) and in the interactive-force-control paper phases, `> 0`.
     pub nominal_m: f64,
-    /// [m] range reached during intentional contact (b), in `[0, nominal_m]` (paper: 0).
+    /// \[m\] range reached during intentional contact (b), in `[0, nominal_m]` (paper: 0).
     pub intentional_contact_m: f64,
-    /// [m/s] how fast the range shrinks in (b), `> 0`.
+    /// \[m/s\] how fast the range shrinks in (b), `> 0`.
     pub shrink_rate_mps: f64,
-    /// [m/s] how fast it is restored in (a), `> 0`.
+    /// \[m/s\] how fast it is restored in (a), `> 0`.
     pub restore_rate_mps: f64,
 }
 
@@ -122,7 +126,7 @@ pub struct FusionShift {
     pub w_contact: f64,
     /// Logistic steepness over the normalized shift time `s ∈ [0, 1]`, `> 0`.
     pub gain: f64,
-    /// [s] duration of the shift, `> 0`.
+    /// \[s\] duration of the shift, `> 0`.
     pub duration_s: f64,
 }
 
@@ -142,7 +146,7 @@ pub struct SupervisorParams {
     pub dwell: DwellTimes,
     /// Sensing range and its ramp.
     pub sensing_range: SensingRange,
-    /// δ_t of intentional-contact paper eq. (11) [1/s], `> 0`.
+    /// δ_t of intentional-contact paper eq. (11) \[1/s\], `> 0`.
     pub smoothing_gain_per_s: f64,
     /// Fusion weight shift (interactive-force-control paper).
     pub fusion: FusionShift,
@@ -243,6 +247,7 @@ impl SupervisorParams {
         non_negative(p, "contact_release_s", d.contact_release_s)?;
         non_negative(p, "goal_reached_s", d.goal_reached_s)?;
         non_negative(p, "clear_s", d.clear_s)?;
+        non_negative(p, "retry_interval_s", d.retry_interval_s)?;
 
         let r = &self.sensing_range;
         let p = "sensing_range.";

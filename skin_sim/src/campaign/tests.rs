@@ -11,7 +11,7 @@ fn scenes_are_reproducible_from_the_seed() {
 
 #[test]
 fn one_scene_per_family_runs_and_is_judged() {
-    let (results, summary) = run(1, FAMILIES.len(), 2, |_, _| {});
+    let (results, summary) = run(1, FAMILIES.len(), 2, None, |_, _| {});
     for r in &results {
         assert!(r.error.is_none(), "scene {} ({}): {:?}", r.id, r.family, r.error);
         assert!(r.verdict.is_some() && r.metrics.is_some());

@@ -55,13 +55,13 @@ pub struct SceneSpec {
     /// How the run is shown: camera and frame rate of the rendered frames and video.
     #[serde(default)]
     pub view: ViewSpec,
-    /// What a run must show (`skin_sim::outcome`; none: the defaults of its kind of scene).
+    /// What a run must show (`skin_sim::outputs::outcome`; none: the defaults of its kind of scene).
     #[serde(default)]
     pub expect: Option<ExpectSpec>,
 }
 
 /// The outcome a run of the scene must show (`expect:`), beside what every run is checked for
-/// (`skin_sim::safety`) and what every scene of its kind must show (a force scene: the first
+/// (`skin_sim::outputs::safety`) and what every scene of its kind must show (a force scene: the first
 /// touch, the rise, a finite from-touch RMS; a scene without goals and force references: no
 /// link presses on anything). Absent: a scene with goals expects the supervisor's goal
 /// tolerance and `ε_c`.

@@ -1,5 +1,5 @@
 //! Simulated planar LIDAR: a fan of rays in the x-y plane of the scanner's frame, cast against
-//! objects and persons ([`crate::mjcf::SENSED_GROUPS`], never the robot), reported as 2-D points in the BASE
+//! objects and persons ([`crate::world::mjcf::SENSED_GROUPS`], never the robot), reported as 2-D points in the BASE
 //! frame (x forward, y left): the closest-obstacle points that base avoidance consumes (interactive-force-control paper
 //! eq. (15)-(17)). Ranges get optional seeded Gaussian noise.
 
@@ -7,11 +7,10 @@ use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
 use nalgebra::{Isometry3, Point3, Vector3};
 
-use crate::frames::FrameRef;
-use crate::noise::Noise;
-use crate::proximity_rays::ProximityRays;
 use crate::scene::Scene;
-use skin_core::resolver::BASE_JOINTS;
+use crate::world::frames::FrameRef;
+use crate::world::noise::Noise;
+use crate::world::proximity_rays::ProximityRays;
 
 /// Noise stream of the LIDAR (see [`Noise::new`]).
 const NOISE_STREAM: u64 = 2;
@@ -41,7 +40,7 @@ impl Lidar {
         let model = &scene.model;
         // Scene validation checked both frames.
         let frame = model.frame_index(&spec.frame)?;
-        let base = model.joint_child_frame(model.joint_index(BASE_JOINTS[2])?);
+        let base = model.joint_child_frame(model.planar_base()?[2]);
         let scanner = FrameRef::new(model, mj, frame);
         let base_ref = FrameRef::new(model, mj, base);
         let fov = spec.fov_deg.to_radians();
@@ -108,7 +107,7 @@ impl Lidar {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mjcf::SENSED_GROUPS;
+    use crate::world::mjcf::SENSED_GROUPS;
     use crate::World;
 
     /// The scan of `lidar` as one `mj_ray` per ray against every geom.

@@ -3,7 +3,7 @@
 //! characteristics of `config/skin_model.yaml` (interactive-force-control paper Sec. 2.3: normalized, nonlinear).
 //!
 //! - Proximity: a ray from the cell's world position along its outward normal, testing only
-//!   objects and persons (`crate::mjcf::SENSED_GROUPS`: the robot never sees itself) near the
+//!   objects and persons (`crate::world::mjcf::SENSED_GROUPS`: the robot never sees itself) near the
 //!   ray ([`ProximityRays`]); the hit distance goes through `p(d)` (0 from the sensor range on).
 //!   A cell in contact reads 1.
 //! - Force: the contacts of one robot geom with one other geom give their summed normal force
@@ -33,12 +33,12 @@ use nalgebra::{Point3, Vector3};
 use skin_core::skin::characteristic::{PreparedForce, PreparedProximity};
 use skin_core::skin::signals::CellReading;
 
-use crate::cell_face::CellFace;
-use crate::frames::{body_pose, FrameRef};
-use crate::mjcf::ROBOT_GROUP;
-use crate::noise::Noise;
-use crate::proximity_rays::ProximityRays;
 use crate::scene::Scene;
+use crate::world::cell_face::CellFace;
+use crate::world::frames::{body_pose, FrameRef};
+use crate::world::mjcf::ROBOT_GROUP;
+use crate::world::noise::Noise;
+use crate::world::proximity_rays::ProximityRays;
 
 /// One cell in its MuJoCo body's frame.
 #[derive(Debug, Clone, Copy)]
@@ -362,7 +362,7 @@ impl SkinSensor {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mjcf::SENSED_GROUPS;
+    use crate::world::mjcf::SENSED_GROUPS;
     use crate::World;
     use nalgebra::Isometry3;
 

@@ -102,10 +102,10 @@ declare_params! {
         /// Control rate: the timer's, and `1 / dt` of every cycle.
         pub control_rate_hz: f64 => { unit: "Hz", range: Range::positive(10_000.0), live: false },
         /// `timer`: cycles on the ROS clock; `inputs`: one cycle per complete input set with a
-        /// common stamp (lockstep simulation) ([`Trigger`]).
+        /// common stamp (lockstep simulation).
         pub trigger: Trigger => { choices: "timer | inputs", live: false },
         /// `topic`: follow /supervisor/arrangement; `internal`: the controller's own supervisor
-        /// in the cycle ([`SupervisorSource`]).
+        /// in the cycle.
         pub supervisor: SupervisorSource => { choices: "topic | internal", live: false },
         /// Whether `/scan` is a required input (base avoidance, interactive-force-control paper eq. 15-17).
         pub use_scan: bool => { choices: "true | false", live: false },
@@ -176,6 +176,17 @@ impl TaskControllerParams {
         self.tasks.validate().map_err(|e| format!("tasks.{e}"))?;
         Ok(())
     }
+}
+
+/// The node's own parameters (not `skin.*`, `tasks.*`) as a Markdown table, with the values
+/// `config` gives them by default (docs/ros.md).
+pub fn parameter_table(config: &ControllerConfig) -> String {
+    let own: Vec<_> = TaskControllerParams::all_specs()
+        .into_iter()
+        .filter(|s| !s.key.starts_with("skin.") && !s.key.starts_with("tasks."))
+        .collect();
+    let values = serde_json::to_value(TaskControllerParams::defaults(config)).expect("parameters serialize");
+    skin_core::param_file::declare::markdown_table(&own, &values)
 }
 
 /// Range of the input timeouts: a longer one would let the controller command from a state a

@@ -158,8 +158,11 @@ fn main() -> Result<()> {
     let covered = coverage(&model, &resolved, args.pitch);
     for p in &layout.patches {
         let n = layout.cells.iter().filter(|c| c.patch == p.id).count();
-        let share = covered.iter().find(|c| c.link == p.link).map_or(1.0, |c| c.covered());
-        eprintln!("patch {:>3} {:<28} {:>4} cells, {:>5.1} % of its surface covered", p.id, p.link, n, 100.0 * share);
+        let share = match covered.iter().find(|c| c.link == p.link).and_then(|c| c.covered()) {
+            Some(share) => format!("{:>5.1} % of its surface covered", 100.0 * share),
+            None => "coverage not measured (meshes are not sampled)".into(),
+        };
+        eprintln!("patch {:>3} {:<28} {:>4} cells, {share}", p.id, p.link, n);
     }
     eprintln!("{}: {} patches, {} cells", out.display(), layout.patches.len(), layout.cells.len());
     Ok(())

@@ -29,12 +29,9 @@ pub struct LinkCoverage {
 }
 
 impl LinkCoverage {
-    /// Covered fraction of the sampled surface.
-    pub fn covered(&self) -> f64 {
-        if self.samples == 0 {
-            return 1.0;
-        }
-        1.0 - self.blind as f64 / self.samples as f64
+    /// Covered fraction of the sampled surface (None: nothing sampled, a link of meshes).
+    pub fn covered(&self) -> Option<f64> {
+        (self.samples > 0).then(|| 1.0 - self.blind as f64 / self.samples as f64)
     }
 }
 

@@ -470,6 +470,12 @@ impl TaskControllerHandle {
         }
     }
 
+    /// Whether the node was shut down through its lifecycle (`change_state` shutdown): the
+    /// service's reply is then still on its way to the caller.
+    pub fn finalized(&self) -> bool {
+        self.shared.borrow().lifecycle.state() == lifecycle::State::Finalized
+    }
+
     /// The controller's counts (cycles, safe-stop steps).
     pub fn counts(&self) -> (u64, u64) {
         self.shared.borrow().tc.counts()

@@ -109,20 +109,11 @@ impl SimBridge {
         let spec = scene.spec.clone();
         let world = World::from_scene(scene).map_err(|e| e.to_string())?;
         let model = &world.scene().model;
-        let base = model.planar_base();
-        let indices: Vec<usize> = (0..model.nv()).filter(|j| !base.is_some_and(|b| b.contains(j))).collect();
+        let indices = world.arm_joints().to_vec();
         let names = indices.iter().map(|&j| model.joint_names()[j].clone()).collect();
         let arms = split_arms(model.joint_names(), world.arm_joints(), namespaces, prefixes)?;
         let scan_geometry = spec.lidar.as_ref().map(|l| {
-            let fov = l.fov_deg.to_radians();
-            let step = if l.rays == 1 {
-                0.0
-            } else if l.fov_deg >= 360.0 {
-                fov / l.rays as f64
-            } else {
-                fov / (l.rays - 1) as f64
-            };
-            let first = if l.rays == 1 { 0.0 } else { -fov / 2.0 };
+            let (first, step) = l.fan();
             (l.frame.clone(), first as f32, step as f32, l.range_m as f32)
         });
         let mut goals: Vec<_> = spec
@@ -142,7 +133,7 @@ impl SimBridge {
             twist: [0.0; 3],
             names,
             indices,
-            base,
+            base: model.planar_base(),
             arms,
             scan_geometry,
             goals,

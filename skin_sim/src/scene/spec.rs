@@ -221,6 +221,22 @@ pub struct LidarSpec {
     pub noise_std_m: f64,
 }
 
+impl LidarSpec {
+    /// The fan's first ray angle and the angle between rays \[rad\], in the scanner frame: a full
+    /// circle has no end ray, a partial fan includes both of its edges.
+    pub fn fan(&self) -> (f64, f64) {
+        let fov = self.fov_deg.to_radians();
+        let step = if self.rays == 1 {
+            0.0
+        } else if self.fov_deg >= 360.0 {
+            fov / self.rays as f64
+        } else {
+            fov / (self.rays - 1) as f64
+        };
+        (if self.rays == 1 { 0.0 } else { -fov / 2.0 }, step)
+    }
+}
+
 fn default_lidar_frame() -> String {
     "laser".into()
 }

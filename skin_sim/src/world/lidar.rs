@@ -43,16 +43,7 @@ impl Lidar {
         let base = model.joint_child_frame(model.planar_base()?[2]);
         let scanner = FrameRef::new(model, mj, frame);
         let base_ref = FrameRef::new(model, mj, base);
-        let fov = spec.fov_deg.to_radians();
-        // A full circle has no end ray; a partial fan includes both of its edges.
-        let step = if spec.rays == 1 {
-            0.0
-        } else if spec.fov_deg >= 360.0 {
-            fov / spec.rays as f64
-        } else {
-            fov / (spec.rays - 1) as f64
-        };
-        let first = if spec.rays == 1 { 0.0 } else { -fov / 2.0 };
+        let (first, step) = spec.fan();
         let directions = (0..spec.rays)
             .map(|k| {
                 let a = first + step * k as f64;

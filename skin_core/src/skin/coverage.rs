@@ -8,7 +8,7 @@
 use nalgebra::{Point3, Vector3};
 
 use super::resolved::ResolvedLayout;
-use super::surface::{buried, samples};
+use super::surface::{buried_in_others, samples};
 use super::tiling::TiledCell;
 use crate::model::{Collision, RobotModel, Shape};
 
@@ -54,11 +54,7 @@ pub fn surface(
         let c = &collisions[i];
         for s in sample(&c.shape) {
             let p = c.origin * Point3::from(s.position);
-            let hidden = collisions
-                .iter()
-                .enumerate()
-                .any(|(j, o)| j != i && buried(&o.shape, &(o.origin.inverse() * p).coords, 1e-3 * reach));
-            if !hidden {
+            if !buried_in_others(collisions, i, &p, 1e-3 * reach) {
                 out.push(TiledCell { position: p.coords, normal: c.origin.rotation * s.normal });
             }
         }

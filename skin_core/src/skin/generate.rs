@@ -11,7 +11,7 @@ use thiserror::Error;
 use super::coverage::{blind_points, surface};
 use super::layout::{CellSpec, PatchSpec, SkinLayout};
 use super::mesh_tiling::tile_mesh;
-use super::surface::buried;
+use super::surface::buried_in_others;
 use super::tiling::{tile_box, tile_caps, tile_cylinder, tile_sphere, Face, TiledCell};
 use crate::mesh::{self, MeshError, MeshMode, PackagePath};
 use crate::model::{RobotModel, Shape};
@@ -222,9 +222,7 @@ pub fn generate_layout(model: &RobotModel, spec: &GeneratorSpec) -> Result<SkinL
             })?;
             cells.extend(tiled.into_iter().filter_map(|cell| {
                 let p = c.origin * Point3::from(cell.position);
-                let hidden = collisions.iter().enumerate().any(|(j, o)| {
-                    j != i && buried(&o.shape, &(o.origin.inverse() * p).coords, BURIED_MARGIN * spec.pitch_m)
-                });
+                let hidden = buried_in_others(collisions, i, &p, BURIED_MARGIN * spec.pitch_m);
                 (!hidden).then(|| TiledCell { position: p.coords, normal: c.origin.rotation * cell.normal })
             }));
         }

@@ -3,10 +3,10 @@
 //! nothing), and evenly spread sample points with their outward normals. Primitive frame, URDF
 //! conventions (see [`super::tiling`]). Meshes have no inside and no samples here.
 
-use nalgebra::Vector3;
+use nalgebra::{Point3, Vector3};
 
 use super::tiling::{tile_box, tile_caps, tile_cylinder, tile_sphere, Face, TiledCell};
-use crate::model::Shape;
+use crate::model::{Collision, Shape};
 
 /// Whether `p` lies inside `shape` deeper than `margin` (a point on the surface is not).
 pub fn buried(shape: &Shape, p: &Vector3<f64>, margin: f64) -> bool {
@@ -20,6 +20,12 @@ pub fn buried(shape: &Shape, p: &Vector3<f64>, margin: f64) -> bool {
         }
         Shape::Mesh { .. } => false,
     }
+}
+
+/// Whether `p` (link frame) lies deeper than `margin` inside one of the link's `collisions`
+/// other than the one at index `own` (the primitive `p` belongs to).
+pub fn buried_in_others(collisions: &[Collision], own: usize, p: &Point3<f64>, margin: f64) -> bool {
+    collisions.iter().enumerate().any(|(j, o)| j != own && buried(&o.shape, &(o.origin.inverse() * p).coords, margin))
 }
 
 /// Points on the surface of `shape` about `spacing` apart, each with its outward normal: every

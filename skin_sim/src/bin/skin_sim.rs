@@ -65,7 +65,8 @@ enum Command {
     /// damping; write results.json and generate the document with its figures.
     Sweep(SweepArgs),
     /// Generate the performance document (cost curves of `Controller::update` over cells, active
-    /// cells and joints, with their figures) from the benchmark results of `make bench`.
+    /// cells and joints, and the simulation's speed per scenario, with their figures) from the
+    /// benchmark results of `make bench`.
     Performance {
         /// The benchmark medians.
         #[arg(long, default_value = "out/bench/summary.json")]
@@ -247,8 +248,8 @@ fn run(args: Command) -> anyhow::Result<bool> {
         Command::Sweep(args) => return sweep(args),
         Command::Campaign(args) => return campaign(args),
         Command::Performance { summary, stages, doc } => {
-            let series = skin_sim::performance::load(&summary, &stages)?;
-            let files = skin_sim::performance::write(&series, [&summary, &stages], &doc)?;
+            let measured = skin_sim::performance::load(&summary, &stages)?;
+            let files = skin_sim::performance::write(&measured, [&summary, &stages], &doc)?;
             let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
             println!("wrote {}", names.join(", "));
             return Ok(true);

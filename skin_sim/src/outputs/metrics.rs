@@ -24,6 +24,29 @@ pub const RECOVERY_LIMIT_S: f64 = 0.5;
 /// rise the from-reach RMS leaves out is bounded (measured 0.46-1.85 s with the approach bound).
 pub const FORCE_RISE_LIMIT_S: f64 = 2.0;
 
+/// A run's wall-clock time by part \[s\].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LoopTime {
+    /// In `mj_step`.
+    pub physics_s: f64,
+    /// In the simulated skin and LIDAR.
+    pub sensors_s: f64,
+    /// In `Controller::update` (a graph run: as the controller node reported it).
+    pub controller_s: f64,
+    /// The rest: the recording and the view (a graph run: also the wait for the controller).
+    pub other_s: f64,
+}
+
+impl LoopTime {
+    fn of(record: &RunRecord) -> LoopTime {
+        let physics_s = record.busy.physics.as_secs_f64();
+        let sensors_s = record.busy.sensors.as_secs_f64();
+        let controller_s = record.cycles.iter().map(|c| c.compute_us).sum::<f64>() * 1e-6;
+        let other_s = record.wall_time_s - physics_s - sensors_s - controller_s;
+        LoopTime { physics_s, sensors_s, controller_s, other_s }
+    }
+}
+
 /// One arrangement switch, as written to `metrics.json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SwitchEntry {
@@ -49,6 +72,10 @@ pub struct Metrics {
     pub max_joint_speed_rad_s: f64,
     /// Median wall-clock time of `Controller::update` \[µs\].
     pub control_cycle_us_p50: f64,
+    /// Where the run's wall-clock time went.
+    pub loop_time_s: LoopTime,
+    /// The real-time factor the physics alone allows: simulated time / time in `mj_step`.
+    pub realtime_factor_physics_bound: f64,
     /// Arrangement switches.
     pub arrangement_switches: Vec<SwitchEntry>,
     /// Cycles that were safe-stop steps (a fault of the controller or of its inputs).
@@ -191,6 +218,8 @@ pub fn compute(record: &RunRecord, scene: &Scene, limits: &Limits) -> Metrics {
         sim_duration_s: sim,
         max_joint_speed_rad_s: max_joint_speed,
         control_cycle_us_p50: median(cycles.iter().map(|c| c.compute_us).collect()),
+        loop_time_s: LoopTime::of(record),
+        realtime_factor_physics_bound: sim / record.busy.physics.as_secs_f64(),
         arrangement_switches: record
             .switches
             .iter()

@@ -127,7 +127,7 @@ pub fn checks(m: &Metrics, expect: Option<&ExpectSpec>) -> Vec<Check> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::outputs::metrics::GoalMetrics;
+    use crate::outputs::metrics::{GoalMetrics, LoopTime};
     use crate::outputs::safety::SafetyMetrics;
 
     fn goal_run(outcome: &'static str, error_m: f64, peak_n: f64) -> Metrics {
@@ -137,6 +137,8 @@ mod tests {
             sim_duration_s: 20.0,
             max_joint_speed_rad_s: 0.1,
             control_cycle_us_p50: 4.0,
+            loop_time_s: LoopTime { physics_s: 0.1, sensors_s: 0.05, controller_s: 0.02, other_s: 0.03 },
+            realtime_factor_physics_bound: 200.0,
             arrangement_switches: vec![],
             faulted_cycles: 0,
             safety: SafetyMetrics {

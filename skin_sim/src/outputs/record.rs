@@ -2,7 +2,7 @@
 //! arrangement switches, everything the metrics, the summary, the plots (`skin_sim::outputs::plot`) and the
 //! bag writer (the `skin_bag` crate) read. Plain data; nothing in it is computed twice.
 
-use crate::world::KeyFrame;
+use crate::world::{BusyTime, KeyFrame};
 use skin_core::supervisor::{Mode, SupervisorInput};
 
 use crate::outputs::view::View;
@@ -102,6 +102,8 @@ pub struct RunRecord {
     pub switches: Vec<Switch>,
     /// Wall-clock duration of the run \[s\].
     pub wall_time_s: f64,
+    /// Of that, the world's physics and sensors (the rest: the controller, the recording).
+    pub busy: BusyTime,
     /// The MJCF the run simulated (primitive geoms only: self-contained).
     pub mjcf: String,
     /// What a viewer sees: frames at the view rate and the key frames (the start, the first
@@ -124,6 +126,7 @@ impl RunRecord {
     pub fn without_timing(&self) -> RunRecord {
         let mut r = self.clone();
         r.wall_time_s = 0.0;
+        r.busy = BusyTime::default();
         for c in &mut r.cycles {
             c.compute_us = 0.0;
         }

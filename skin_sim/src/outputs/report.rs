@@ -38,6 +38,12 @@ impl RunReport {
             "  {:.1} s simulated in {:.1} s (realtime factor {:.2}), controller update p50 {:.0} us",
             m.sim_duration_s, self.record.wall_time_s, m.realtime_factor, m.control_cycle_us_p50
         );
+        let l = &m.loop_time_s;
+        let _ = writeln!(
+            s,
+            "  wall time: physics {:.2} s, sensors {:.2} s, controller {:.2} s, other {:.2} s (physics alone: realtime factor {:.0})",
+            l.physics_s, l.sensors_s, l.controller_s, l.other_s, m.realtime_factor_physics_bound
+        );
         let _ = writeln!(s, "  max arm joint speed {:.3} rad/s", m.max_joint_speed_rad_s);
         let switches: Vec<String> =
             m.arrangement_switches.iter().map(|w| format!("{:.2} s {} -> {}", w.t, w.from, w.to)).collect();

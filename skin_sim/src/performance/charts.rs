@@ -1,5 +1,6 @@
 //! The performance figures: per series, the time of one cycle at each point as a bar stacked by
-//! stage (PNG, the shipped font).
+//! stage; per scenario, the wall time of a simulated second as a bar stacked by part of the loop
+//! (PNG, the shipped font).
 
 use std::path::Path;
 
@@ -7,6 +8,7 @@ use anyhow::anyhow;
 use plotters::prelude::*;
 use skin_core::controller::Stage;
 
+use super::simulator::{SimPoint, PARTS};
 use super::Series;
 use crate::outputs::plot::{font, legend, FONT, PALETTE};
 
@@ -63,5 +65,59 @@ pub fn stacked(series: &Series, path: &Path) -> anyhow::Result<()> {
         }))
         .map_err(err)?;
     legend(&mut chart, SeriesLabelPosition::UpperLeft).map_err(err)?;
+    root.present().map_err(err)
+}
+
+/// `<key>.png`: wall milliseconds per simulated second of each scenario, stacked by part of the
+/// loop, with the real-time factor over each bar.
+pub fn loop_parts(points: &[SimPoint], path: &Path) -> anyhow::Result<()> {
+    font().map_err(err)?;
+    let top = points.iter().map(|p| p.ms_per_s.iter().sum::<f64>()).fold(0.0, f64::max) * 1.15;
+    let root = BitMapBackend::new(path, (900, 520)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption("Wall time per simulated second, by part of the loop", (FONT, 19))
+        .margin(14)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d(-0.6..points.len() as f64 - 0.4, 0.0..top.max(1e-3))
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .y_desc("wall time [ms] per simulated s")
+        .label_style((FONT, 11))
+        .axis_desc_style((FONT, 13))
+        .x_labels(points.len())
+        .x_label_formatter(&|v| {
+            let k = v.round();
+            if (v - k).abs() > 1e-6 || k < 0.0 {
+                return String::new();
+            }
+            points.get(k as usize).map_or_else(String::new, |p| p.name.clone())
+        })
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .draw()
+        .map_err(err)?;
+    for (k, part) in PARTS.into_iter().enumerate() {
+        let colour = PALETTE[k];
+        let bars = points.iter().enumerate().map(move |(i, p)| {
+            let below: f64 = p.ms_per_s[..k].iter().sum();
+            let x = i as f64;
+            Rectangle::new([(x - 0.3, below), (x + 0.3, below + p.ms_per_s[k])], colour.mix(0.85).filled())
+        });
+        chart
+            .draw_series(bars)
+            .map_err(err)?
+            .label(part)
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], colour.mix(0.85).filled()));
+    }
+    chart
+        .draw_series(points.iter().enumerate().map(|(i, p)| {
+            let total: f64 = p.ms_per_s.iter().sum();
+            Text::new(format!("{:.0}x", p.realtime_factor), (i as f64 - 0.15, total + top * 0.01), (FONT, 12))
+        }))
+        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperRight).map_err(err)?;
     root.present().map_err(err)
 }

@@ -6,7 +6,11 @@ use std::path::Path;
 
 use skin_core::controller::Stage;
 
-use super::{poly_fit, BenchPoint, Series};
+use super::simulator::{SimPoint, PARTS};
+use super::{poly_fit, BenchPoint, Measurements, Series};
+
+/// File stem of the simulation-speed figure.
+pub const SIMULATOR_FIGURE: &str = "simulator";
 
 /// Microseconds with one decimal.
 fn us(ns: f64) -> String {
@@ -93,7 +97,8 @@ fn dominant(s: &Series) -> String {
 }
 
 /// The whole document; `stem` names the figures' directory.
-pub fn render(series: &[Series], sources: [&Path; 2], stem: &str) -> String {
+pub fn render(measured: &Measurements, sources: [&Path; 2], stem: &str) -> String {
+    let series = &measured.series[..];
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -187,5 +192,55 @@ pub fn render(series: &[Series], sources: [&Path; 2], stem: &str) -> String {
         let _ = writeln!(out, "- {}: {}.", s.title, dominant(s));
     }
     out.push('\n');
+    simulator(&mut out, &measured.simulator, stem);
     out
+}
+
+/// The simulation's speed per scenario and what bounds it.
+fn simulator(out: &mut String, points: &[SimPoint], stem: &str) {
+    out.push_str("## The simulation loop\n\n");
+    if points.is_empty() {
+        out.push_str("Not measured: `make bench` runs every scenario (`scripts/bench_sim.py`) for these figures.\n");
+        return;
+    }
+    let _ = writeln!(out, "![Wall time per simulated second, by part]({stem}/{SIMULATOR_FIGURE}.png)\n");
+    out.push_str(
+        "Each scenario run in process (`skin_sim run`, release build, best of three runs), its wall time \
+         split by clock reads around `mj_step` and the simulated sensors in `World::step`, and around \
+         `Controller::update`; **other** is the rest of the loop (the recording, the view). The physics \
+         bound is the real-time factor with the sensors, the controller and the rest at zero cost: \
+         simulated time over the time in `mj_step`.\n\n",
+    );
+    let _ = writeln!(
+        out,
+        "| scenario | real-time factor | physics bound | {} |",
+        PARTS.map(|p| format!("{p} [ms/s]")).join(" | ")
+    );
+    let _ = writeln!(out, "|---|---:|---:|{}", "---:|".repeat(PARTS.len()));
+    for p in points {
+        let parts: Vec<String> = p.ms_per_s.iter().map(|ms| format!("{ms:.1}")).collect();
+        let _ = writeln!(
+            out,
+            "| `{}` | {:.0} | {:.0} | {} |",
+            p.name,
+            p.realtime_factor,
+            p.physics_bound,
+            parts.join(" | ")
+        );
+    }
+    let slowest = points.iter().min_by(|a, b| a.physics_bound.total_cmp(&b.physics_bound)).expect("not empty");
+    let physics_share = |p: &SimPoint| p.ms_per_s[0] / p.ms_per_s.iter().sum::<f64>();
+    let (lo, hi) =
+        points.iter().map(physics_share).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| (lo.min(s), hi.max(s)));
+    let _ = writeln!(
+        out,
+        "\nWhat dominates: the physics, {:.0}-{:.0} % of the wall time. No faster sensing or control can \
+         make a scenario run faster than its physics bound ({:.0} for `{}`); only a cheaper step can: a \
+         longer timestep (`docs/tradeoffs.md` measures what it costs in accuracy), fewer contact pairs, \
+         or a cheaper solver, each of which changes what is simulated.\n",
+        100.0 * lo,
+        100.0 * hi,
+        slowest.physics_bound,
+        slowest.name
+    );
 }

@@ -1,16 +1,20 @@
 //! `docs/performance.md` and its figures, generated from the benchmark results (`make bench`:
 //! `out/bench/summary.json` for the medians, `out/bench/stages.json` for each point's sizes and
 //! stage shares): how the cost of `Controller::update` grows with the number of cells, of active
-//! cells and of joints, and which stage dominates where (`skin_sim performance`).
+//! cells and of joints, and which stage dominates where; and the simulation's own speed per
+//! scenario, part by part (`skin_sim performance`).
 
 mod charts;
 mod doc;
+pub mod simulator;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use skin_core::controller::Stage;
+
+use simulator::SimPoint;
 
 /// One measured point: its median and what it measured.
 #[derive(Debug, Clone, PartialEq)]
@@ -77,8 +81,17 @@ const SERIES: [(&str, &str, &str, &str); 4] = [
 /// The robots of the joints' series.
 const ROBOTS: [&str; 3] = ["planar7", "tomm", "humanoid"];
 
+/// What `make bench` measured.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measurements {
+    /// The controller's cost curves.
+    pub series: Vec<Series>,
+    /// The simulation's speed per scenario (empty when the bench did not run the scenarios).
+    pub simulator: Vec<SimPoint>,
+}
+
 /// Reads the points present in both files.
-pub fn load(summary: &Path, stages: &Path) -> anyhow::Result<Vec<Series>> {
+pub fn load(summary: &Path, stages: &Path) -> anyhow::Result<Measurements> {
     let read = |p: &Path| std::fs::read_to_string(p).with_context(|| format!("reading {}", p.display()));
     let medians: BTreeMap<String, f64> =
         serde_json::from_str(&read(summary)?).with_context(|| format!("parsing {}", summary.display()))?;
@@ -138,7 +151,7 @@ pub fn load(summary: &Path, stages: &Path) -> anyhow::Result<Vec<Series>> {
         }
         all.push(Series { key, title, x_label, points });
     }
-    Ok(all)
+    Ok(Measurements { series: all, simulator: simulator::points(&medians) })
 }
 
 /// Least-squares polynomial of `degree` (1 or 2) through `(x, y)`: coefficients from the
@@ -156,17 +169,22 @@ pub fn poly_fit(xy: &[(f64, f64)], degree: usize) -> Option<Vec<f64>> {
 
 /// Writes the figures into the directory named after `doc` beside it (`docs/performance/`) and
 /// the document; returns the files written.
-pub fn write(series: &[Series], sources: [&Path; 2], doc: &Path) -> anyhow::Result<Vec<PathBuf>> {
+pub fn write(measured: &Measurements, sources: [&Path; 2], doc: &Path) -> anyhow::Result<Vec<PathBuf>> {
     let stem = doc.file_stem().context("the document path has no file name")?.to_string_lossy().into_owned();
     let images = doc.with_file_name(&stem);
     std::fs::create_dir_all(&images).with_context(|| format!("creating {}", images.display()))?;
     let mut files = Vec::new();
-    for s in series {
+    for s in &measured.series {
         let path = images.join(format!("{}.png", s.key));
         charts::stacked(s, &path).with_context(|| format!("drawing {}", path.display()))?;
         files.push(path);
     }
-    let text = doc::render(series, sources, &stem);
+    if !measured.simulator.is_empty() {
+        let path = images.join(format!("{}.png", doc::SIMULATOR_FIGURE));
+        charts::loop_parts(&measured.simulator, &path).with_context(|| format!("drawing {}", path.display()))?;
+        files.push(path);
+    }
+    let text = doc::render(measured, sources, &stem);
     std::fs::write(doc, text).with_context(|| format!("writing {}", doc.display()))?;
     files.push(doc.to_path_buf());
     Ok(files)

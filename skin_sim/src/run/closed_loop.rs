@@ -112,6 +112,7 @@ impl ClosedLoop {
             cycles: Vec::new(),
             switches: Vec::new(),
             wall_time_s: 0.0,
+            busy: Default::default(),
             mjcf: world.mjcf().to_string(),
             view: Default::default(),
         };
@@ -224,6 +225,7 @@ impl ClosedLoop {
             progress((k + 1) as f64 / cycles as f64);
         }
         self.record.wall_time_s = start.elapsed().as_secs_f64();
+        self.record.busy = self.world.busy_time();
         let mode = self.record.cycles.last().map_or(self.controller.output().mode, |c| c.mode);
         self.record.view = self.view.finish(&self.world, mode);
         self.record

@@ -225,6 +225,7 @@ impl ExternalRun {
     /// [`ExternalRun::new`].
     pub fn finish(mut self, world: &crate::world::World) -> RunReport {
         self.record.wall_time_s = self.started.elapsed().as_secs_f64();
+        self.record.busy = world.busy_time();
         let mode = self.record.cycles.last().map_or(Mode::Avoidance, |c| c.mode);
         self.record.view = self.view.finish(world, mode);
         self.target.report(self.record, &self.scene, self.limits)

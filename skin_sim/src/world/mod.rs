@@ -15,6 +15,7 @@ pub mod skin_sensor;
 
 use std::path::Path;
 use std::sync::Once;
+use std::time::{Duration, Instant};
 
 use mujoco_rs::prelude::*;
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -142,6 +143,16 @@ pub struct World {
     lidar_every: u64,
     q: Vec<f64>,
     qd: Vec<f64>,
+    busy: BusyTime,
+}
+
+/// Wall-clock time the world's steps spent so far, by part (what bounds the simulation's speed).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BusyTime {
+    /// In `mj_step`: collision detection, the constraint solver, integration.
+    pub physics: Duration,
+    /// In the simulated sensors (skin rays and contact forces, LIDAR scans) at their rates.
+    pub sensors: Duration,
 }
 
 /// Routes MuJoCo's messages to the `log` crate once per process, instead of MUJOCO_LOG.TXT in
@@ -230,6 +241,7 @@ impl World {
             lidar_every,
             q: scene.q0.clone(),
             qd: vec![0.0; n],
+            busy: BusyTime::default(),
             scene,
         };
         for (j, io) in world.joints.iter().enumerate() {
@@ -346,10 +358,19 @@ impl World {
     /// skin and the LIDAR when their periods come round.
     pub fn step(&mut self) {
         self.apply_inputs();
+        let start = Instant::now();
         self.data.step();
+        let stepped = Instant::now();
         self.steps += 1;
         self.read_state();
         self.sample_due_sensors();
+        self.busy.physics += stepped - start;
+        self.busy.sensors += stepped.elapsed();
+    }
+
+    /// Wall-clock time [`World::step`] spent so far in the physics and in the sensors.
+    pub fn busy_time(&self) -> BusyTime {
+        self.busy
     }
 
     /// Samples the skin and scans with the LIDAR now, at the current state (the steps do it at

@@ -444,9 +444,11 @@ impl Controller {
                 self.solver.solve_with_model(active, posture, true, &mut self.tau_k)
             }
             HierarchyDynamics::Admittance | HierarchyDynamics::AdmittanceInertia => {
-                self.resolver.virtual_dynamics(input.q, input.qd, input.dt_s, &mut self.mass, &mut self.bias);
-                if self.config.setup.hierarchy_dynamics == HierarchyDynamics::AdmittanceInertia {
-                    self.bias.fill(0.0); // the resolver's damping stays: bias g alone
+                self.resolver.virtual_mass(input.q, &mut self.mass);
+                if self.config.setup.hierarchy_dynamics == HierarchyDynamics::Admittance {
+                    self.resolver.virtual_damping(input.q, input.qd, input.dt_s, &mut self.bias);
+                } else {
+                    self.bias.fill(0.0); // the resolver's damping stays out: bias g alone
                 }
                 for (j, _) in self.locked.iter().enumerate().filter(|(_, &l)| l) {
                     self.bias[j] = 0.0;

@@ -74,7 +74,7 @@ pub enum HierarchyDynamics {
     /// projection decoupled: intentional-contact paper's force levels are tuned with it.
     #[default]
     Model,
-    /// The resolver's virtual dynamics (`Resolver::virtual_dynamics`: `M_a`, `M_b`, bias
+    /// The resolver's virtual dynamics (`Resolver::virtual_mass`, `virtual_damping`: `M_a`, `M_b`, bias
     /// `g + C_a q̇`): the executed acceleration is the hierarchy's, so strict priority holds in the
     /// motion the robot makes (interactive-force-control paper's acceleration levels: hand force, wrist).
     Admittance,

@@ -337,53 +337,60 @@ impl Resolver {
         Ok(&self.commands)
     }
 
-    /// The virtual dynamics of eq. (26) in model order and world axes, for a hierarchy that must
-    /// predict what the resolver executes: `mass` = `M_a` on the arm joints, `R M_b Rᵀ` on the
-    /// base (`R` the yaw rotation: `M_b`, `D_b` are constant in the base frame), and
-    /// `damping_torque` = `C_a v` / `R D_b Rᵀ v` with `v` the virtual velocity the next update
-    /// starts from (the last command pulled towards `qd_measured` by the inner loop). A hierarchy
-    /// solved with this `mass` and the bias `g + damping_torque` makes the executed acceleration
-    /// its own `M_v⁻¹ Σ τ̄` (up to the zero-order hold), so a lower level cannot leak into a higher
-    /// one through the mismatch between `M(q)` and `M_a`. Off-diagonal entries are zero.
-    pub fn virtual_dynamics(
+    /// The virtual inertia of eq. (26) in model order and world axes, for a hierarchy that must
+    /// predict what the resolver executes: `M_a` on the arm joints, `R M_b Rᵀ` on the base (`R`
+    /// the yaw rotation: `M_b` is constant in the base frame); off-diagonal entries are zero. A
+    /// hierarchy solved with this `mass` and the bias `g` + [`Resolver::virtual_damping`] makes
+    /// the executed acceleration its own `M_v⁻¹ Σ τ̄` (up to the zero-order hold), so a lower
+    /// level cannot leak into a higher one through the mismatch between `M(q)` and `M_a`.
+    pub fn virtual_mass(&self, q_measured: &[f64], mass: &mut nalgebra::DMatrix<f64>) {
+        mass.fill(0.0);
+        for a in &self.arm {
+            mass[(a.index, a.index)] = a.inertia;
+        }
+        let Some(b) = self.base else { return };
+        let m = Self::base_frame_to_world(q_measured[b[2]], self.params.base.inertia);
+        for (r, &i) in b[..2].iter().enumerate() {
+            for (k, &j) in b[..2].iter().enumerate() {
+                mass[(i, j)] = m[(r, k)];
+            }
+        }
+        mass[(b[2], b[2])] = self.params.base.inertia[2];
+    }
+
+    /// The virtual damping torque of eq. (26) in model order and world axes: `C_a v` on the arm
+    /// joints, `R D_b Rᵀ v` on the base, with `v` the virtual velocity the next update starts
+    /// from (the last command pulled towards `qd_measured` by the inner loop).
+    pub fn virtual_damping(
         &self,
         q_measured: &[f64],
         qd_measured: &[f64],
         dt_s: f64,
-        mass: &mut nalgebra::DMatrix<f64>,
         damping_torque: &mut nalgebra::DVector<f64>,
     ) {
-        mass.fill(0.0);
         damping_torque.fill(0.0);
         let sync = |gain: f64| -(-gain * dt_s).exp_m1();
         let s = sync(self.params.arm.sync_gain_per_s);
         for (a, &cmd) in self.arm.iter().zip(&self.commands.joint_velocities) {
-            let v = cmd + s * (qd_measured[a.index] - cmd);
-            mass[(a.index, a.index)] = a.inertia;
-            damping_torque[a.index] = a.damping * v;
+            damping_torque[a.index] = a.damping * (cmd + s * (qd_measured[a.index] - cmd));
         }
         let Some(b) = self.base else { return };
         let p = &self.params.base;
         let s = sync(p.sync_gain_per_s);
         let last = to_world_frame(self.commands.base_twist, q_measured[b[2]]);
         let v: [f64; 3] = core::array::from_fn(|k| last[k] + s * (qd_measured[b[k]] - last[k]));
-        let (sn, c) = q_measured[b[2]].sin_cos();
-        let rot = nalgebra::Matrix2::new(c, -sn, sn, c);
-        let m = rot
-            * nalgebra::Matrix2::from_diagonal(&nalgebra::Vector2::new(p.inertia[0], p.inertia[1]))
-            * rot.transpose();
-        let d = rot
-            * nalgebra::Matrix2::from_diagonal(&nalgebra::Vector2::new(p.damping[0], p.damping[1]))
-            * rot.transpose();
-        let f = d * nalgebra::Vector2::new(v[0], v[1]);
+        let f = Self::base_frame_to_world(q_measured[b[2]], p.damping) * nalgebra::Vector2::new(v[0], v[1]);
         for (r, &i) in b[..2].iter().enumerate() {
-            for (k, &j) in b[..2].iter().enumerate() {
-                mass[(i, j)] = m[(r, k)];
-            }
             damping_torque[i] = f[r];
         }
-        mass[(b[2], b[2])] = p.inertia[2];
         damping_torque[b[2]] = p.damping[2] * v[2];
+    }
+
+    /// `R diag(x, y) Rᵀ`: a base-frame diagonal (the first two of `xyz`) in world axes at `yaw`.
+    fn base_frame_to_world(yaw: f64, xyz: [f64; 3]) -> nalgebra::Matrix2<f64> {
+        let (sn, c) = yaw.sin_cos();
+        let rot = nalgebra::Matrix2::new(c, -sn, sn, c);
+        rot * nalgebra::Matrix2::from_diagonal(&nalgebra::Vector2::new(xyz[0], xyz[1])) * rot.transpose()
     }
 
     /// [`Resolver::update_arms`] and [`Resolver::update_base`] with one `dt` (both parts at one

@@ -448,7 +448,7 @@ proptest! {
 
 #[test]
 fn virtual_dynamics_predict_what_the_resolver_executes() {
-    // A torque g + M_v a + C v (virtual_dynamics) accelerates every joint by a, the base in world
+    // A torque g + M_v a + C v (virtual_mass, virtual_damping) accelerates every joint by a, the base in world
     // axes too at any yaw and with anisotropic M_b (up to the zero-order hold: C dt / 2M, 1 % on the arms).
     let m = model("tomm");
     let mut p = ResolverParams::default();
@@ -462,7 +462,8 @@ fn virtual_dynamics_predict_what_the_resolver_executes() {
     r.reset(q.as_slice(), qd.as_slice()).unwrap();
     let a = DVector::from_fn(n, |i, _| 0.5 * (i as f64 * 0.7).cos());
     let (mut mass, mut damping) = (nalgebra::DMatrix::zeros(n, n), DVector::zeros(n));
-    r.virtual_dynamics(q.as_slice(), qd.as_slice(), BASE_DT, &mut mass, &mut damping);
+    r.virtual_mass(q.as_slice(), &mut mass);
+    r.virtual_damping(q.as_slice(), qd.as_slice(), BASE_DT, &mut damping);
     let g = DVector::from_fn(n, |j, _| if [bx, by, byaw].contains(&j) { 0.0 } else { 3.0 }); // the arms' gravity
     let tau = &mass * &a + &damping + &g;
     r.update(tau.as_slice(), g.as_slice(), q.as_slice(), qd.as_slice(), BASE_DT).unwrap();

@@ -11,8 +11,8 @@ use nalgebra::{Isometry3, Quaternion as NaQuaternion, Translation3, UnitQuaterni
 use skin_core::skin::markers::{MarkerAction, MarkerShape, Rgba, SkinMarker};
 
 use crate::outputs::plot::{
-    guidance_figure, intervals_where, paper000_figure, paper003_figure, GuidanceSignals, Paper000Signals,
-    Paper003Signals,
+    force_tracking_figure, guidance_figure, intentional_contact_figure, intervals_where, ForceTrackingSignals,
+    GuidanceSignals, IntentionalContactSignals,
 };
 use crate::outputs::record::{CycleRecord, RunRecord};
 use crate::outputs::report::{MetricsJson, RunOutput, RunReport, SummaryText};
@@ -125,9 +125,9 @@ impl RunOutput for FigurePng {
         } else if phases {
             let phase: Vec<usize> = c.iter().map(|c| usize::from(c.mode == Mode::Contact)).collect();
             let base_speed = column(c, |c| c.base_twist[0].hypot(c.base_twist[1]));
-            paper003_figure(
+            force_tracking_figure(
                 &title,
-                &Paper003Signals {
+                &ForceTrackingSignals {
                     t: &t,
                     force_desired: &column(c, |c| c.force_reference_n),
                     force_measured: &column(c, |c| c.hand_force_n),
@@ -141,9 +141,9 @@ impl RunOutput for FigurePng {
         } else {
             // Table I's (a), (b), (c) are modes 0, 1, 2
             let arrangement: Vec<usize> = c.iter().map(|c| (c.mode.as_u8() as usize).min(2)).collect();
-            paper000_figure(
+            intentional_contact_figure(
                 &title,
-                &Paper000Signals {
+                &IntentionalContactSignals {
                     t: &t,
                     arrangement: &arrangement,
                     ee_speed: &column(c, |c| c.signals.ee_speed_mps),

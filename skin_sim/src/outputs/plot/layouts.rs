@@ -5,7 +5,7 @@ use super::{intervals_where, Figure, Panel, Tint};
 /// Signals of an intentional-contact paper run, laid out like its Figs. 3, 7 and 8; one sample per control cycle,
 /// every slice as long as `t`.
 #[derive(Debug, Clone, Copy)]
-pub struct Paper000Signals<'a> {
+pub struct IntentionalContactSignals<'a> {
     /// Time \[s\].
     pub t: &'a [f64],
     /// Active arrangement of Table I per sample: 0 = (a) avoidance first, 1 = (b) intentional
@@ -30,10 +30,10 @@ pub struct Paper000Signals<'a> {
 /// Intentional-contact paper's figure: (a) arrangement, (b) end-effector speed with eps_v, (c) proximity force,
 /// (d) contact force with eps_c, (e) torque norm; intentional-contact periods (arrangement (b))
 /// and pushes shaded.
-pub fn paper000_figure(title: &str, s: &Paper000Signals) -> Figure {
+pub fn intentional_contact_figure(title: &str, s: &IntentionalContactSignals) -> Figure {
     let t = s.t;
     let contact: Vec<bool> = s.arrangement.iter().map(|&a| a == 1).collect();
-    let mut fig = Figure::new(title)
+    let fig = Figure::new(title)
         .panel(Panel::steps(
             "(a) Priority arrangement (Table I)",
             "arrangement",
@@ -57,19 +57,17 @@ pub fn paper000_figure(title: &str, s: &Paper000Signals) -> Figure {
                 .threshold("eps_c", s.eps_c),
         )
         .panel(Panel::lines("(e) Torque norm", "torque [N m]").line("||tau||", t, s.torque_norm));
-    for (a, b) in intervals_where(t, &contact) {
-        fig = fig.shade(a, b, "intentional contact", Tint::Green);
-    }
-    for &(a, b) in s.pushes {
-        fig = fig.shade(a, b, "external push", Tint::Red);
-    }
-    fig
+    fig.shade_all(&intervals_where(t, &contact), "intentional contact", Tint::Green).shade_all(
+        s.pushes,
+        "external push",
+        Tint::Red,
+    )
 }
 
-/// Signals of a interactive-force-control paper force experiment, laid out like its Figs. 5, 7 and 8; one sample per
+/// Signals of an interactive-force-control paper force experiment, laid out like its Figs. 5, 7 and 8; one sample per
 /// control cycle, every slice as long as `t`.
 #[derive(Debug, Clone, Copy)]
-pub struct Paper003Signals<'a> {
+pub struct ForceTrackingSignals<'a> {
     /// Time \[s\].
     pub t: &'a [f64],
     /// Desired normal hand force \[N\].
@@ -92,7 +90,7 @@ pub struct Paper003Signals<'a> {
 /// Interactive-force-control paper's figure: (a) desired and measured hand force, (b) force error with its RMS over
 /// the contact phase (the measure of Table 3), (c) phase, (d) fusion weight, (e) base speed;
 /// tactile and base-avoidance periods shaded.
-pub fn paper003_figure(title: &str, s: &Paper003Signals) -> Figure {
+pub fn force_tracking_figure(title: &str, s: &ForceTrackingSignals) -> Figure {
     let t = s.t;
     let error: Vec<f64> = s.force_measured.iter().zip(s.force_desired).map(|(m, d)| m - d).collect();
     let in_contact = error.iter().zip(s.phase).filter(|(_, &p)| p == 1).map(|(e, _)| e * e);
@@ -101,7 +99,7 @@ pub fn paper003_figure(title: &str, s: &Paper003Signals) -> Figure {
         0 => "(b) Force error".to_string(),
         _ => format!("(b) Force error (RMS in contact {:.3} N)", (sum / n as f64).sqrt()),
     };
-    let mut fig = Figure::new(title)
+    let fig = Figure::new(title)
         .panel(
             Panel::lines("(a) Hand force", "force [N]")
                 .line("measured", t, s.force_measured)
@@ -112,13 +110,11 @@ pub fn paper003_figure(title: &str, s: &Paper003Signals) -> Figure {
         .panel(Panel::steps("(c) Phase (Table 1)", "phase", &["pre-contact", "contact"], t, s.phase))
         .panel(Panel::lines("(d) Fusion weight (eq. 6)", "w [-]").line("w", t, s.fusion_weight))
         .panel(Panel::lines("(e) Mobile-base speed", "speed [m/s]").line("||v_b||", t, s.base_speed));
-    for &(a, b) in s.tactile {
-        fig = fig.shade(a, b, "tactile guidance", Tint::Green);
-    }
-    for &(a, b) in s.interaction {
-        fig = fig.shade(a, b, "interaction (touch, person)", Tint::Red);
-    }
-    fig
+    fig.shade_all(s.tactile, "tactile guidance", Tint::Green).shade_all(
+        s.interaction,
+        "interaction (touch, person)",
+        Tint::Red,
+    )
 }
 
 /// Signals of interactive-force-control paper's Exp. 2 (pre-contact approach and tactile guidance), laid out like its
@@ -171,8 +167,5 @@ pub fn guidance_figure(title: &str, s: &GuidanceSignals) -> Figure {
                 .line("z", t, s.hand[2]),
         )
         .panel(Panel::lines("(d) Base position", "w_x_b [m]").line("x", t, s.base[0]).line("y", t, s.base[1]));
-    for &(a, b) in s.interaction {
-        fig = fig.shade(a, b, "interaction (touch, person)", Tint::Red);
-    }
-    fig
+    fig.shade_all(s.interaction, "interaction (touch, person)", Tint::Red)
 }

@@ -26,7 +26,8 @@ use thiserror::Error;
 // The study's charts (`crate::study::charts`) draw with the same font and colours.
 pub(crate) use draw::{font, legend, FONT, PALETTE};
 pub use layouts::{
-    guidance_figure, paper000_figure, paper003_figure, GuidanceSignals, Paper000Signals, Paper003Signals,
+    force_tracking_figure, guidance_figure, intentional_contact_figure, ForceTrackingSignals, GuidanceSignals,
+    IntentionalContactSignals,
 };
 
 /// Errors building or writing a figure; each names the output file.
@@ -225,6 +226,11 @@ impl Figure {
     pub fn shade(mut self, start: f64, end: f64, label: &str, tint: Tint) -> Self {
         self.intervals.push(Interval { start, end, label: label.into(), tint });
         self
+    }
+
+    /// [`Figure::shade`] for each `(start, end)` of `periods`.
+    pub fn shade_all(self, periods: &[(f64, f64)], label: &str, tint: Tint) -> Self {
+        periods.iter().fold(self, |fig, &(a, b)| fig.shade(a, b, label, tint))
     }
 
     /// Image size \[px\]: (width, title band + one panel height per panel).

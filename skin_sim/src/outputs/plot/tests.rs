@@ -2,7 +2,7 @@ use super::*;
 
 /// A synthetic 20 s paper-000 run at 100 Hz: a local minimum at 6 s, intentional contact until
 /// 12 s, a push 14-15 s that forces arrangement (c).
-fn paper000_run() -> Figure {
+fn intentional_contact_run() -> Figure {
     let t: Vec<f64> = (0..2001).map(|k| k as f64 * 0.01).collect();
     let arrangement: Vec<usize> = t
         .iter()
@@ -20,7 +20,7 @@ fn paper000_run() -> Figure {
     let prox: Vec<f64> = t.iter().map(|t| 4.0 * (-(t - 5.0) * (t - 5.0)).exp()).collect();
     let contact: Vec<f64> = t.iter().map(|&t| if (7.0..12.0).contains(&t) { 3.0 } else { 0.0 }).collect();
     let torque: Vec<f64> = t.iter().map(|t| 10.0 + 5.0 * (0.5 * t).cos()).collect();
-    let signals = Paper000Signals {
+    let signals = IntentionalContactSignals {
         t: &t,
         arrangement: &arrangement,
         ee_speed: &speed,
@@ -31,7 +31,7 @@ fn paper000_run() -> Figure {
         torque_norm: &torque,
         pushes: &[(14.0, 15.0)],
     };
-    paper000_figure("synthetic intentional-contact paper run", &signals)
+    intentional_contact_figure("synthetic intentional-contact paper run", &signals)
 }
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -42,7 +42,7 @@ fn temp_dir(name: &str) -> PathBuf {
 
 #[test]
 fn png_has_the_expected_size_and_is_deterministic() {
-    let fig = paper000_run();
+    let fig = intentional_contact_run();
     assert_eq!(fig.pixel_size(), (1000, 36 + 5 * 190));
     let dir = temp_dir("png");
     let (a, b) = (dir.join("a.png"), dir.join("b.png"));
@@ -60,7 +60,7 @@ fn png_has_the_expected_size_and_is_deterministic() {
 
 #[test]
 fn pixels_show_lines_text_and_shading() {
-    let rgb = paper000_run().render_rgb().unwrap();
+    let rgb = intentional_contact_run().render_rgb().unwrap();
     let pixels: Vec<&[u8]> = rgb.chunks(3).collect();
     let share = |f: &dyn Fn(&[u8]) -> bool| pixels.iter().filter(|p| f(p)).count() as f64 / pixels.len() as f64;
     let white = share(&|p| p.iter().all(|&c| c == 255));
@@ -82,7 +82,7 @@ fn pixels_show_lines_text_and_shading() {
 fn svg_carries_the_panel_titles() {
     let dir = temp_dir("svg");
     let path = dir.join("fig.svg");
-    paper000_run().save_svg(&path).unwrap();
+    intentional_contact_run().save_svg(&path).unwrap();
     let svg = std::fs::read_to_string(&path).unwrap();
     assert!(svg.starts_with("<svg"));
     assert!(svg.contains("(d) Largest contact force") && svg.contains("eps_c"));
@@ -90,7 +90,7 @@ fn svg_carries_the_panel_titles() {
 }
 
 #[test]
-fn paper003_layout_reports_the_contact_rms_error() {
+fn force_tracking_layout_reports_the_contact_rms_error() {
     let t: Vec<f64> = (0..1000).map(|k| k as f64 * 0.01).collect();
     let phase: Vec<usize> = t.iter().map(|&t| usize::from(t >= 3.0)).collect();
     let desired: Vec<f64> = t.iter().map(|&t| if t >= 3.0 { 5.0 + 2.0 * (t * 1.57).sin() } else { 0.0 }).collect();
@@ -103,9 +103,9 @@ fn paper003_layout_reports_the_contact_rms_error() {
         .collect();
     let w: Vec<f64> = phase.iter().map(|&p| p as f64).collect();
     let base: Vec<f64> = t.iter().map(|t| 0.1 * t.sin().abs()).collect();
-    let fig = paper003_figure(
+    let fig = force_tracking_figure(
         "synthetic force tracking",
-        &Paper003Signals {
+        &ForceTrackingSignals {
             t: &t,
             force_desired: &desired,
             force_measured: &measured,

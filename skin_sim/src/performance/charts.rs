@@ -8,8 +8,8 @@ use anyhow::anyhow;
 use plotters::prelude::*;
 use skin_core::controller::Stage;
 
+use super::measurements::Series;
 use super::simulator::{SimPoint, PARTS};
-use super::Series;
 use crate::outputs::plot::{font, legend, FONT, PALETTE};
 
 fn err(e: impl std::fmt::Display) -> anyhow::Error {

@@ -6,8 +6,8 @@ use std::path::Path;
 
 use skin_core::controller::Stage;
 
+use super::measurements::{poly_fit, BenchPoint, Measurements, Series};
 use super::simulator::{SimPoint, PARTS};
-use super::{poly_fit, BenchPoint, Measurements, Series};
 
 /// File stem of the simulation-speed figure.
 pub const SIMULATOR_FIGURE: &str = "simulator";

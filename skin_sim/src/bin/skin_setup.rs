@@ -17,7 +17,8 @@ use clap::Parser;
 use skin_core::mesh::MeshMode;
 use skin_core::model::BASE_JOINTS;
 use skin_sim::new_robot::base::with_planar_base;
-use skin_sim::new_robot::{pose, write_files, Choices};
+use skin_sim::new_robot::write::write_files;
+use skin_sim::new_robot::{pose, Choices};
 
 /// Write a skin layout, a controller setup and a reach-past-an-obstacle scene for a URDF.
 #[derive(Parser, Debug)]

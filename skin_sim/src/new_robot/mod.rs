@@ -10,7 +10,7 @@
 
 pub mod base;
 pub mod pose;
-mod write;
+pub mod write;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -21,8 +21,6 @@ use skin_core::model::BASE_JOINTS;
 use skin_core::skin::generate::{generate_layout, GeneratorSpec, LinkSelection, PatchFrame};
 use skin_core::skin::layout::SkinLayout;
 use thiserror::Error;
-
-pub use write::{write_files, Written};
 
 /// What the user chooses about a new robot.
 #[derive(Debug, Clone, PartialEq)]

@@ -9,7 +9,7 @@
 //!   eigenvalue is inverted by the filter [`InverseParams::filter`].
 
 use super::dense::sub_outer_padded_kernel;
-use super::HierarchyError;
+use super::error::HierarchyError;
 
 /// Parameters of the damped, rank-aware inverse of `A = J̄ M⁻¹ J̄ᵀ` (interactive-force-control paper eq. 23, 25).
 ///

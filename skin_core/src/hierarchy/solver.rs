@@ -10,10 +10,11 @@ use super::dense::{
     mul_vec_padded, norm, pad, padded_len, set_identity_padded, sub_mul_nt, sub_mul_nt_padded,
     sub_outer_mul_vec_padded, sub_outer_padded, unpad,
 };
+use super::error::HierarchyError;
 use super::inverse::{
     cholesky, damped_inverse, lower_inverse_padded, spd_inverse_padded, symmetric_eigen, InverseParams,
 };
-use super::{HierarchyError, ReferenceKind, TaskLevel};
+use super::task::{ReferenceKind, TaskLevel};
 
 /// What one level did in the last solve.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -2,7 +2,7 @@
 
 use nalgebra::{DMatrixSlice, Dim, Matrix, Storage};
 
-use super::HierarchyError;
+use super::error::HierarchyError;
 
 /// What a level asks for: a task-space acceleration (interactive-force-control paper eq. 9, 10, 12) or a task-space
 /// force (intentional-contact paper eq. 3-6). Borrowed: [`TaskLevel::push`] copies it into the level's storage.

@@ -11,7 +11,7 @@ use std::collections::HashMap;
 use nalgebra::{Matrix4, Point3, Unit, Vector3};
 use roxmltree::{Document, Node};
 
-use super::TriMesh;
+use super::tri_mesh::TriMesh;
 
 fn numbers<T: std::str::FromStr>(text: Option<&str>, what: &str) -> Result<Vec<T>, String> {
     text.unwrap_or("")

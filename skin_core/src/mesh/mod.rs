@@ -4,35 +4,20 @@
 //! box [`TriMesh::fitted_box`] when a scene asks for primitives).
 
 pub mod collada;
+mod error;
+mod file;
 pub mod package;
+mod tri_mesh;
 
 use std::path::Path;
 
-use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, SymmetricEigen, Translation3, UnitQuaternion, Vector3};
-use thiserror::Error;
+use nalgebra::Vector3;
 
+pub use error::MeshError;
 pub use package::PackagePath;
-
-/// Why a mesh could not be had.
-#[derive(Debug, Error)]
-pub enum MeshError {
-    /// The URI resolves to no file.
-    #[error("mesh `{uri}` not found (searched: {searched})")]
-    NotFound {
-        /// The URI as written in the URDF.
-        uri: String,
-        /// The places looked at.
-        searched: String,
-    },
-    /// The file could not be read or parsed.
-    #[error("{file}: {reason}")]
-    Read {
-        /// The mesh file.
-        file: String,
-        /// What went wrong.
-        reason: String,
-    },
-}
+#[cfg(test)]
+pub(crate) use tri_mesh::box_mesh;
+pub use tri_mesh::TriMesh;
 
 /// How a URDF mesh collision element is used: the mesh itself, or its fitted box (the
 /// primitive approximation). Chosen per layout (`skin_layout --meshes`) and per scene
@@ -61,185 +46,5 @@ impl std::str::FromStr for MeshMode {
 /// Loads the mesh `uri` (as written in a `<mesh filename>` of the URDF file `urdf`) scaled by
 /// `scale`, resolving `package://` URIs over `path`.
 pub fn load_uri(uri: &str, scale: &Vector3<f64>, urdf: &Path, path: &PackagePath) -> Result<TriMesh, MeshError> {
-    TriMesh::load(&path.resolve(uri, urdf)?, scale)
-}
-
-/// A triangle soup in metres, in the frame of the URDF `<collision>` element (scale applied).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct TriMesh {
-    /// Vertex positions \[m\].
-    pub vertices: Vec<Vector3<f64>>,
-    /// Vertex indices of each triangle (counter-clockwise seen from outside, when the file says so).
-    pub triangles: Vec<[usize; 3]>,
-}
-
-impl TriMesh {
-    /// Reads `path` (`.stl`, `.obj` or `.dae`, case-insensitive) and multiplies by `scale`.
-    pub fn load(path: &Path, scale: &Vector3<f64>) -> Result<TriMesh, MeshError> {
-        let file = path.display().to_string();
-        let read = |reason: String| MeshError::Read { file: file.clone(), reason };
-        let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
-        let mut mesh = match ext.as_str() {
-            "stl" => {
-                let mut f = std::fs::File::open(path).map_err(|e| read(e.to_string()))?;
-                let m = stl_io::read_stl(&mut f).map_err(|e| read(e.to_string()))?;
-                TriMesh {
-                    vertices: m.vertices.iter().map(|v| Vector3::new(v[0] as f64, v[1] as f64, v[2] as f64)).collect(),
-                    triangles: m.faces.iter().map(|f| f.vertices).collect(),
-                }
-            }
-            "obj" => {
-                let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
-                let (models, _) = tobj::load_obj(path, &opts).map_err(|e| read(e.to_string()))?;
-                let mut out = TriMesh::default();
-                for m in models {
-                    let base = out.vertices.len();
-                    out.vertices.extend(
-                        m.mesh.positions.chunks_exact(3).map(|p| Vector3::new(p[0] as f64, p[1] as f64, p[2] as f64)),
-                    );
-                    out.triangles.extend(
-                        m.mesh
-                            .indices
-                            .chunks_exact(3)
-                            .map(|t| [base + t[0] as usize, base + t[1] as usize, base + t[2] as usize]),
-                    );
-                }
-                out
-            }
-            "dae" => {
-                let text = std::fs::read_to_string(path).map_err(|e| read(e.to_string()))?;
-                collada::read(&text).map_err(read)?
-            }
-            other => return Err(read(format!("unsupported mesh format `.{other}` (STL, OBJ and DAE are read)"))),
-        };
-        if mesh.triangles.is_empty() {
-            return Err(read("no triangles".into()));
-        }
-        if let Some(bad) = mesh.triangles.iter().flatten().find(|&&i| i >= mesh.vertices.len()) {
-            return Err(read(format!("triangle vertex index {bad} beyond {} vertices", mesh.vertices.len())));
-        }
-        for v in &mut mesh.vertices {
-            v.component_mul_assign(scale);
-        }
-        Ok(mesh)
-    }
-
-    /// Total surface area \[m²\].
-    pub fn area(&self) -> f64 {
-        self.triangles.iter().map(|t| self.triangle_normal(t).norm() / 2.0).sum()
-    }
-
-    /// `(b - a) × (c - a)` of a triangle: twice its area along its normal.
-    pub fn triangle_normal(&self, t: &[usize; 3]) -> Vector3<f64> {
-        let [a, b, c] = t.map(|i| self.vertices[i]);
-        (b - a).cross(&(c - a))
-    }
-
-    /// The box that encloses the vertices, aligned with their principal axes (the eigenvectors
-    /// of their covariance): its pose in the mesh frame and its full edge lengths. The primitive
-    /// approximation of a mesh.
-    pub fn fitted_box(&self) -> (Isometry3<f64>, Vector3<f64>) {
-        let n = self.vertices.len().max(1) as f64;
-        let mean: Vector3<f64> = self.vertices.iter().sum::<Vector3<f64>>() / n;
-        let cov: Matrix3<f64> =
-            self.vertices.iter().map(|v| (v - mean) * (v - mean).transpose()).sum::<Matrix3<f64>>() / n;
-        let eig = SymmetricEigen::new(cov);
-        let mut axes = eig.eigenvectors;
-        if axes.determinant() < 0.0 {
-            axes.set_column(2, &-axes.column(2));
-        }
-        let (mut lo, mut hi) = (Vector3::repeat(f64::MAX), Vector3::repeat(f64::MIN));
-        for v in &self.vertices {
-            let p = axes.transpose() * v;
-            lo = lo.inf(&p);
-            hi = hi.sup(&p);
-        }
-        let centre = axes * ((lo + hi) / 2.0);
-        let rotation = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(axes));
-        (Isometry3::from_parts(Translation3::from(centre), rotation), hi - lo)
-    }
-
-    /// Whether `p` lies inside the closed mesh: the parity of the crossings of a ray from `p`
-    /// (Möller–Trumbore), along a fixed direction not aligned with any axis.
-    pub fn contains(&self, p: &Point3<f64>) -> bool {
-        let dir = Vector3::new(0.5773, 0.5774, 0.5775).normalize();
-        let mut crossings = 0;
-        for t in &self.triangles {
-            let [a, b, c] = t.map(|i| self.vertices[i]);
-            let (e1, e2) = (b - a, c - a);
-            let h = dir.cross(&e2);
-            let det = e1.dot(&h);
-            if det.abs() < 1e-18 {
-                continue;
-            }
-            let s = p.coords - a;
-            let u = s.dot(&h) / det;
-            if !(0.0..=1.0).contains(&u) {
-                continue;
-            }
-            let q = s.cross(&e1);
-            let v = dir.dot(&q) / det;
-            if v < 0.0 || u + v > 1.0 {
-                continue;
-            }
-            if e2.dot(&q) / det > 0.0 {
-                crossings += 1;
-            }
-        }
-        crossings % 2 == 1
-    }
-}
-
-/// A closed box mesh of full edge lengths `s` centred at the origin, outward winding (inward
-/// when `inverted`).
-#[cfg(test)]
-pub(crate) fn box_mesh(s: Vector3<f64>, inverted: bool) -> TriMesh {
-    let h = s / 2.0;
-    let corner = |i: usize| {
-        Vector3::new(
-            if i & 1 == 0 { -h.x } else { h.x },
-            if i & 2 == 0 { -h.y } else { h.y },
-            if i & 4 == 0 { -h.z } else { h.z },
-        )
-    };
-    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-    let triangles = quads
-        .iter()
-        .flat_map(|q| {
-            if inverted {
-                [[q[0], q[2], q[1]], [q[0], q[3], q[2]]]
-            } else {
-                [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]
-            }
-        })
-        .collect();
-    TriMesh { vertices: (0..8).map(corner).collect(), triangles }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn box_mesh_area_inside_and_fit() {
-        let m = box_mesh(Vector3::new(0.2, 0.1, 0.4), false);
-        assert!((m.area() - 2.0 * (0.02 + 0.08 + 0.04)).abs() < 1e-12);
-        for t in &m.triangles {
-            let c = t.iter().map(|&i| m.vertices[i]).sum::<Vector3<f64>>() / 3.0;
-            assert!(m.triangle_normal(t).dot(&c) > 0.0, "outward winding");
-        }
-        assert!(m.contains(&Point3::new(0.05, 0.01, 0.1)));
-        assert!(!m.contains(&Point3::new(0.15, 0.0, 0.0)));
-        let (pose, size) = m.fitted_box();
-        let mut sorted: Vec<f64> = size.iter().copied().collect();
-        sorted.sort_by(f64::total_cmp);
-        assert!((sorted[0] - 0.1).abs() < 1e-9 && (sorted[1] - 0.2).abs() < 1e-9 && (sorted[2] - 0.4).abs() < 1e-9);
-        assert!(pose.translation.vector.norm() < 1e-9);
-    }
-
-    #[test]
-    fn unknown_format_names_the_file() {
-        let e = TriMesh::load(Path::new("/nonexistent/x.ply"), &Vector3::repeat(1.0)).unwrap_err().to_string();
-        assert!(e.contains("x.ply") && e.contains("unsupported"), "{e}");
-    }
+    file::read(&path.resolve(uri, urdf)?, scale)
 }

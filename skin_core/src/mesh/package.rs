@@ -8,7 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::MeshError;
+use super::error::MeshError;
 
 /// The directories `package://` URIs are searched in (see the module documentation).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]

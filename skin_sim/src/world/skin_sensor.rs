@@ -4,13 +4,13 @@
 //!
 //! - Proximity: a ray from the cell's world position along its outward normal, testing only
 //!   objects and persons (`crate::world::mjcf::SENSED_GROUPS`: the robot never sees itself) near the
-//!   ray ([`ProximityRays`]); the hit distance goes through `p(d)` (0 from the sensor range on).
+//!   ray (`ProximityRays`); the hit distance goes through `p(d)` (0 from the sensor range on).
 //!   A cell in contact reads 1.
 //! - Force: the contacts of one robot geom with one other geom give their summed normal force
 //!   (`mj_contactForce`), which the cells of the touched body share in proportion to how deep the
-//!   other geom presses into each cell's face ([`CellFace::compression`]: the soft cover's
+//!   other geom presses into each cell's face (`CellFace::compression`: the soft cover's
 //!   pressure integrated over the cell); the cells' normal loads balance the force along its
-//!   direction ([`SkinSensor::distribute`]), and each load in newtons goes through `f(F)` on all
+//!   direction (`SkinSensor::distribute`), and each load in newtons goes through `f(F)` on all
 //!   three sensors. MuJoCo's contact points do not decide the split: it reports a flat contact
 //!   between boxes as corners or, tilted by a hundredth of a radian, as one edge, and split by
 //!   distance to those points a flat palm's load jumped between 8 and 3 cells. When no face is

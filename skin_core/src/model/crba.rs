@@ -2,7 +2,9 @@
 
 use nalgebra::DMatrix;
 
-use super::{ModelData, ModelError, RobotModel};
+use super::data::ModelData;
+use super::error::ModelError;
+use super::robot::RobotModel;
 
 /// Writes the joint-space inertia matrix `M(q)` (full, symmetric) of the configuration of the
 /// last [`super::update_kinematics`] into `m_out` (must be nv × nv).

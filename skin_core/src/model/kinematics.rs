@@ -3,8 +3,10 @@
 
 use nalgebra::{Isometry3, Matrix3, Matrix6xX, Point3, Translation3, Unit, UnitQuaternion, Vector3, Vector6};
 
+use super::data::ModelData;
+use super::error::ModelError;
+use super::robot::{JointKind, RobotModel};
 use super::spatial::{ang, cross_motion, lin, svec, SVec, SpatialInertia};
-use super::{JointKind, ModelData, ModelError, RobotModel};
 
 /// Checks length and finiteness of a joint-space vector; errors name the joint.
 pub(crate) fn check_vector(model: &RobotModel, what: &'static str, x: &[f64]) -> Result<(), ModelError> {
@@ -92,7 +94,7 @@ pub fn update_kinematics(model: &RobotModel, data: &mut ModelData, q: &[f64], qd
 
 /// Value of a moving joint from the generalized coordinates.
 #[inline(always)]
-fn joint_value(b: &super::Body, q: &[f64]) -> f64 {
+fn joint_value(b: &super::robot::Body, q: &[f64]) -> f64 {
     b.multiplier * q[b.coord] + b.offset
 }
 

@@ -2,9 +2,11 @@
 
 use nalgebra::DVector;
 
+use super::data::ModelData;
+use super::error::ModelError;
 use super::kinematics::check_vector;
+use super::robot::RobotModel;
 use super::spatial::{cross_force, svec, SVec};
-use super::{ModelData, ModelError, RobotModel};
 use nalgebra::Vector3;
 
 fn check_out(model: &RobotModel, out: &DVector<f64>) -> Result<(), ModelError> {

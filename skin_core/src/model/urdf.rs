@@ -6,13 +6,38 @@ use std::collections::HashMap;
 
 use nalgebra::{DMatrix, Isometry3, Matrix3, Vector3};
 
+use super::error::ModelError;
 use super::inertia_check::{self, Verdict};
+use super::robot::{
+    Body, Collision, Frame, JointKind, JointLimits, MimicMode, RobotModel, Shape, UrdfOptions, STANDARD_GRAVITY,
+};
 use super::spatial::SpatialInertia;
 use super::urdf_xml::{self, Geometry, JointType, Urdf};
-use super::{
-    Body, Collision, Frame, JointKind, JointLimits, MimicMode, ModelError, RobotModel, Shape, UrdfOptions,
-    STANDARD_GRAVITY,
-};
+
+impl RobotModel {
+    /// Loads and validates a URDF file (plain URDF, no xacro) with the default options.
+    pub fn from_urdf_file(path: &std::path::Path) -> Result<RobotModel, ModelError> {
+        Self::from_urdf_file_with(path, &UrdfOptions::default())
+    }
+
+    /// Loads and validates a URDF file with the given options.
+    pub fn from_urdf_file_with(path: &std::path::Path, options: &UrdfOptions) -> Result<RobotModel, ModelError> {
+        let file = path.display().to_string();
+        let xml = std::fs::read_to_string(path).map_err(|io| ModelError::Io { file: file.clone(), io })?;
+        Self::from_urdf_str_with(&xml, &file, options)
+    }
+
+    /// Loads and validates URDF text with the default options; `source` names it (usually the
+    /// file) in error messages.
+    pub fn from_urdf_str(xml: &str, source: &str) -> Result<RobotModel, ModelError> {
+        Self::from_urdf_str_with(xml, source, &UrdfOptions::default())
+    }
+
+    /// Loads and validates URDF text with the given options.
+    pub fn from_urdf_str_with(xml: &str, source: &str, options: &UrdfOptions) -> Result<RobotModel, ModelError> {
+        build(xml, source, options)
+    }
+}
 
 /// Repair tolerance of link inertias, relative to the largest link inertia of the URDF
 /// (Frobenius norm): a repair changes M by at most this fraction of the robot's inertia scale.

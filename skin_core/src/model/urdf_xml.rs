@@ -10,7 +10,7 @@
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use roxmltree::Node;
 
-use super::ModelError;
+use super::error::ModelError;
 
 /// The parts of a URDF the model is built from.
 pub(crate) struct Urdf {

@@ -10,10 +10,10 @@
 //! `activation_band_m` of the range (`docs/tasks.md`): a cell entering the range changes neither
 //! the torque (`F_di = 0` there) nor the projector of the lower levels by a step.
 
+use super::error::TaskError;
 use super::params::AvoidanceParams;
 use super::point_rows::{push_inward_cell_row, row_activation};
 use super::task::{Cycle, Role, Rows, Task, TaskSetup};
-use super::TaskError;
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::LengthMismatch;

@@ -13,9 +13,9 @@
 
 use nalgebra::{DVector, Vector2, Vector3};
 
+use super::error::TaskError;
 use super::params::BaseAvoidanceParams;
 use super::task::{Cycle, Role, Task, TaskSetup};
-use super::TaskError;
 
 /// A pseudo-angle of the direction `(x, y)` in `[0, 4)`: 0 along +x, 1 along +y, 2 along −x, 3
 /// along −y, strictly increasing with the angle in `[0, 2π)`; four divisions, no `atan2`.

@@ -4,8 +4,8 @@
 
 use nalgebra::DVector;
 
+use super::error::TaskError;
 use super::task::{Cycle, Role, Task, TaskSetup};
-use super::TaskError;
 use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::PatchWrench;
 use crate::skin::layout::ResolvedLayout;

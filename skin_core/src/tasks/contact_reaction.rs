@@ -10,10 +10,10 @@
 //! characteristic of the cell's force signal, for cells above the activity threshold. A row's
 //! activation in the null-space projector rises smoothly with `F_i` (`activation_force_n`).
 
+use super::error::TaskError;
 use super::params::ContactReactionParams;
 use super::point_rows::{push_inward_cell_row, row_activation};
 use super::task::{Cycle, Role, Rows, Task, TaskSetup};
-use super::TaskError;
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::{FusionParams, LengthMismatch};

@@ -8,9 +8,10 @@
 
 use nalgebra::{Matrix6xX, UnitQuaternion, Vector3};
 
+use super::error::TaskError;
 use super::params::GoalParams;
 use super::task::{Cycle, Role, Rows, Task, TaskSetup};
-use super::{rows_times_qd, TaskError};
+use super::terms::rows_times_qd;
 use crate::hierarchy::{Reference, TaskLevel};
 use crate::model::{point_jacobian, ModelData, RobotModel};
 

@@ -21,10 +21,10 @@
 
 use nalgebra::Vector3;
 
+use super::error::TaskError;
 use super::params::HandForceParams;
 use super::point_rows::{PointRows, ANGULAR, LINEAR};
 use super::task::{Cycle, Role, Rows, Task, TaskSetup};
-use super::TaskError;
 use crate::hierarchy::{Reference, TaskLevel};
 use crate::model::{ModelData, RobotModel};
 use crate::skin::characteristic::ProximityCharacteristic;

@@ -24,6 +24,7 @@ pub mod avoidance;
 pub mod base_avoidance;
 pub mod compliance;
 pub mod contact_reaction;
+mod error;
 pub mod goal;
 pub mod hand_force;
 pub mod params;
@@ -32,17 +33,13 @@ pub mod position_hold;
 pub mod posture;
 pub mod tactile_guidance;
 pub mod task;
+mod terms;
 pub mod wrist;
 
 #[cfg(test)]
 mod tests;
 
-use nalgebra::{Matrix6xX, Vector3};
-use thiserror::Error;
-
-use crate::hierarchy::HierarchyError;
-use crate::model::ModelError;
-use crate::skin::aggregate::LengthMismatch;
+pub use error::TaskError;
 pub use task::{entry, BaseReference, Cycle, HandSignals, Role, Rows, Task, TaskEntry, TaskSetup};
 
 /// Every task by its name in `config/supervisor.yaml`. A new task is a file with its `impl Task`,
@@ -67,56 +64,4 @@ pub static REGISTRY: std::sync::LazyLock<Vec<TaskEntry>> = std::sync::LazyLock::
 /// The registered task called `name`.
 pub fn lookup(name: &str) -> Option<&'static TaskEntry> {
     REGISTRY.iter().find(|e| e.name == name)
-}
-
-/// Errors of a task update.
-#[derive(Debug, Error)]
-pub enum TaskError {
-    /// Kinematics query failed (bad frame, non-finite point, wrong size).
-    #[error(transparent)]
-    Model(#[from] ModelError),
-    /// The level rejected the rows (too many rows, wrong sizes).
-    #[error(transparent)]
-    Level(#[from] HierarchyError),
-    /// Skin readings do not match the layout.
-    #[error(transparent)]
-    Skin(#[from] LengthMismatch),
-    /// A per-cycle input has the wrong length.
-    #[error("{what}: expected length {expected}, got {got}")]
-    Length {
-        /// What was wrong.
-        what: &'static str,
-        /// Expected length.
-        expected: usize,
-        /// Given length.
-        got: usize,
-    },
-    /// A per-cycle input is NaN or infinite.
-    #[error("{what}[{index}] is not finite")]
-    NonFinite {
-        /// What was wrong.
-        what: &'static str,
-        /// Index of the first bad value.
-        index: usize,
-    },
-}
-
-/// `J[row0..row0+3] q̇` of a 6 × nv Jacobian (linear rows: 0, angular rows: 3), no allocation.
-pub(crate) fn rows_times_qd(jac: &Matrix6xX<f64>, row0: usize, qd: &[f64]) -> Vector3<f64> {
-    let mut v = Vector3::zeros();
-    for (c, q) in qd.iter().enumerate().take(jac.ncols()) {
-        for r in 0..3 {
-            v[r] += jac[(row0 + r, c)] * q;
-        }
-    }
-    v
-}
-
-/// Reference acceleration of interactive-force-control paper eq. (4)/(5) per axis: `(k e − d ẋ) / λ`.
-pub(crate) fn impedance_acceleration(
-    imp: &params::Impedance3,
-    error: &Vector3<f64>,
-    velocity: &Vector3<f64>,
-) -> Vector3<f64> {
-    Vector3::from_fn(|i, _| (imp.k[i] * error[i] - imp.d[i] * velocity[i]) / imp.lambda[i])
 }

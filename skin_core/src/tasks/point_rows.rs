@@ -4,7 +4,8 @@
 
 use nalgebra::{Matrix6xX, Vector3, Vector6};
 
-use super::{rows_times_qd, TaskError};
+use super::error::TaskError;
+use super::terms::rows_times_qd;
 use crate::hierarchy::{Reference, TaskLevel};
 use crate::model::{point_jacobian, point_jacobian_along, point_jacobian_dot_qdot, ModelData, RobotModel};
 use crate::skin::layout::ResolvedCell;

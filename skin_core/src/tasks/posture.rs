@@ -11,9 +11,9 @@
 
 use nalgebra::DVector;
 
+use super::error::TaskError;
 use super::params::{BaseGains, PostureParams};
 use super::task::{BaseReference, Cycle, Role, Task, TaskSetup};
-use super::TaskError;
 use crate::model::ModelData;
 
 /// Joint compliance / posture torque.

@@ -8,10 +8,11 @@
 
 use nalgebra::Vector3;
 
+use super::error::TaskError;
 use super::params::Impedance3;
 use super::point_rows::{PointRows, LINEAR};
 use super::task::{Cycle, Role, Rows, Task, TaskSetup};
-use super::{impedance_acceleration, TaskError};
+use super::terms::impedance_acceleration;
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
 

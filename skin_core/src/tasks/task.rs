@@ -5,8 +5,8 @@
 
 use nalgebra::{DVector, Isometry3, Vector2, Vector3};
 
+use super::error::TaskError;
 use super::params::TaskParams;
-use super::TaskError;
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
 use crate::skin::aggregate::PatchWrench;

@@ -16,7 +16,7 @@
 //! an uneven distribution reads lower for the same force: the measured newtons (MuJoCo's
 //! contacts, measured by skin_sim's probe) tell how good the assumption is.
 
-use super::ControllerConfig;
+use super::setup::ControllerConfig;
 use crate::skin::characteristic::PreparedForce;
 use nalgebra::Vector3;
 

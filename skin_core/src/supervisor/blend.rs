@@ -93,7 +93,7 @@ impl TorqueBlender {
 
     /// Starts a blend when `arrangement`'s switch time differs from the current one (call once
     /// per cycle before [`Self::apply`]).
-    pub fn sync(&mut self, arrangement: &super::Arrangement) {
+    pub fn sync(&mut self, arrangement: &super::types::Arrangement) {
         if arrangement.switch_time_s.to_bits() != self.switch_time_s.to_bits() {
             if self.has_output {
                 self.start(arrangement.switch_time_s, arrangement.smoothing_gain_per_s);

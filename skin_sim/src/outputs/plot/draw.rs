@@ -8,7 +8,28 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle};
 
-use super::{Content, Figure, Interval, Panel, Tint, TITLE_HEIGHT};
+use super::figure::{Content, Figure, Interval, Panel, PlotError, Tint, TITLE_HEIGHT};
+
+impl Figure {
+    /// Draw to a PNG file.
+    pub fn save_png(&self, path: &Path) -> Result<(), PlotError> {
+        self.check(path)?;
+        to_png(self, path).map_err(|message| PlotError::Draw { path: path.into(), message })
+    }
+
+    /// Draw to an SVG file (text as `<text>` elements in sans-serif).
+    pub fn save_svg(&self, path: &Path) -> Result<(), PlotError> {
+        self.check(path)?;
+        to_svg(self, path).map_err(|message| PlotError::Draw { path: path.into(), message })
+    }
+
+    /// Draw into memory: RGB8 pixels, row-major, [`Figure::pixel_size`] big.
+    pub fn render_rgb(&self) -> Result<Vec<u8>, PlotError> {
+        let path = Path::new("<memory>");
+        self.check(path)?;
+        to_rgb(self).map_err(|message| PlotError::Draw { path: path.into(), message })
+    }
+}
 
 /// Family name the shipped font is registered under (ab_glyph looks fonts up by name).
 pub(crate) const FONT: &str = "sans-serif";

@@ -1,6 +1,6 @@
 //! The two papers' signal figures as ready-made layouts over plain slices.
 
-use super::{intervals_where, Figure, Panel, Tint};
+use super::figure::{intervals_where, Figure, Panel, Tint};
 
 /// Signals of an intentional-contact paper run, laid out like its Figs. 3, 7 and 8; one sample per control cycle,
 /// every slice as long as `t`.

@@ -1,3 +1,5 @@
+use std::path::{Path, PathBuf};
+
 use super::*;
 
 /// A synthetic 20 s paper-000 run at 100 Hz: a local minimum at 6 s, intentional contact until

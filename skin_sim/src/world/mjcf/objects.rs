@@ -7,7 +7,8 @@ use nalgebra::{Isometry3, Vector3};
 use skin_core::model::Shape;
 use skin_core::skin::layout::isometry_from_xyz_rpy;
 
-use super::{pose_attrs, shape_attrs, OBJECT_GROUP, PERSON_GROUP};
+use super::attrs::{pose_attrs, shape_attrs};
+use super::groups::{OBJECT_GROUP, PERSON_GROUP};
 use crate::scene::{ObjectSpec, PersonSpec, ShapeSpec};
 
 /// The primitives of an object, each with its pose in the object frame.

@@ -10,7 +10,9 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use skin_core::mesh::MeshMode;
 use skin_core::model::{update_kinematics, JointKind, JointLimits, ModelData, RobotModel, Shape};
 
-use super::{pose_attrs, shape_attrs, MjcfError, ROBOT_GROUP};
+use super::attrs::{pose_attrs, shape_attrs};
+use super::error::MjcfError;
+use super::groups::ROBOT_GROUP;
 use crate::scene::Scene;
 
 /// The servo reaches its effort limit when the velocity error is this fraction of the joint's

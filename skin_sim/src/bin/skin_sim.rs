@@ -97,6 +97,10 @@ struct CampaignArgs {
     /// Run only this scene (its full outputs go into <out>/<id>/).
     #[arg(long)]
     only: Option<usize>,
+    /// Run only the scenes of this family among the --scenes (planar_contact, tomm_reach,
+    /// force_tracking, tactile_guidance): the same scenes and ids as in the whole campaign.
+    #[arg(long)]
+    family: Option<String>,
     /// Output directory: results.json, summary.json.
     #[arg(long, default_value = "out/campaign")]
     out: PathBuf,
@@ -288,8 +292,9 @@ fn campaign(args: CampaignArgs) -> anyhow::Result<bool> {
         return Ok(failures.is_empty());
     }
     let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    let total = args.scenes;
-    let (results, summary) = campaign::run(args.seed, total, jobs, |done, r| {
+    let only = args.family.as_deref().map(campaign::family).transpose().map_err(anyhow::Error::msg)?;
+    let total = campaign::scene_ids(args.scenes, only).len();
+    let (results, summary) = campaign::run(args.seed, args.scenes, only, jobs, |done, r| {
         if !args.quiet {
             let failures = campaign::failures(r);
             let status = if failures.is_empty() { "ok".to_string() } else { failures.join("; ") };

@@ -164,11 +164,31 @@ pub fn summarize(seed: u64, results: &[SceneResult], wall_s: f64, jobs: usize) -
     }
 }
 
-/// Runs scenes `0..n` of the campaign `seed` on `jobs` threads; `done(finished, result)` after
-/// each.
-pub fn run(seed: u64, n: usize, jobs: usize, mut done: impl FnMut(usize, &SceneResult)) -> (Vec<SceneResult>, Summary) {
+/// The family named `name`, or an error listing the names.
+pub fn family(name: &str) -> Result<Family, String> {
+    FAMILIES.iter().find(|f| f.name == name).copied().ok_or_else(|| {
+        let names: Vec<&str> = FAMILIES.iter().map(|f| f.name).collect();
+        format!("no scene family `{name}` (families: {})", names.join(", "))
+    })
+}
+
+/// The ids among `0..n` of the scenes of family `only` (all without it): the same scenes and ids
+/// as in the whole campaign.
+pub fn scene_ids(n: usize, only: Option<Family>) -> Vec<usize> {
+    (0..n).filter(|id| only.is_none_or(|f| FAMILIES[id % FAMILIES.len()].name == f.name)).collect()
+}
+
+/// Runs the scenes [`scene_ids`]`(n, only)` of the campaign `seed` on `jobs` threads;
+/// `done(finished, result)` after each.
+pub fn run(
+    seed: u64,
+    n: usize,
+    only: Option<Family>,
+    jobs: usize,
+    mut done: impl FnMut(usize, &SceneResult),
+) -> (Vec<SceneResult>, Summary) {
     let start = Instant::now();
-    let ids: Vec<usize> = (0..n).collect();
+    let ids = scene_ids(n, only);
     let mut finished = 0;
     let results = pool::map(
         &ids,

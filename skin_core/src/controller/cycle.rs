@@ -2,6 +2,7 @@
 
 use nalgebra::{DMatrix, DVector, Isometry3};
 
+use super::hand_force::HandForceMap;
 use super::io::{ControllerInput, ControllerOutput, Fault};
 use super::setup::{ControllerConfig, HierarchyDynamics, SetupError};
 use super::stages::{Stage, StageClock, StageTimes};
@@ -10,7 +11,9 @@ use crate::hierarchy::{HierarchySolver, LevelDiagnostics};
 use crate::model::{gravity, point_velocity, update_kinematics, ModelData};
 use crate::resolver::{Commands, Resolver};
 use crate::skin::aggregate::{aggregate_live_patches, FusionParams, PatchWrench};
+use crate::skin::characteristic::PreparedForce;
 use crate::skin::live::LiveCells;
+use crate::skin::measured::measured_contact;
 use crate::skin::transforms::{patch_poses_world, patch_wrench_world, sum_patch_forces_in_frame};
 use crate::supervisor::blend::chi;
 use crate::supervisor::{Arrangement, Imposed, Phase, PhaseRefused, Supervisor, SupervisorInput, TorqueBlender};
@@ -51,8 +54,13 @@ pub struct Controller {
     /// The supervisor's `‖F_d‖` and `‖F_c‖` (whether or not the arrangement has these tasks).
     proximity_signal: ProximityAvoidance,
     contact_signal: ContactReaction,
-    /// Desired fused hand signal `f_c,d` of interactive-force-control paper eq. (9).
-    hand_force_reference: f64,
+    /// Desired hand contact force \[N\]; each cycle's `f_c,d` of interactive-force-control
+    /// paper eq. (9) reads it with the contact's measured distribution (`skin::measured`).
+    hand_force_reference_n: f64,
+    /// The force characteristic, prepared: the hand cells' newtons (`skin::measured`).
+    force: PreparedForce,
+    /// `f_c,d` of an even press of the palm: the reference while nothing presses the hand.
+    hand_map: Option<HandForceMap>,
     /// The commanded base motion, if any.
     base_reference: Option<BaseReference>,
     solver: HierarchySolver,
@@ -177,7 +185,9 @@ impl Controller {
             tasks,
             proximity_signal: ProximityAvoidance::new(nv, config.tasks.avoidance),
             contact_signal: ContactReaction::new(nv, config.tasks.contact_reaction, &config.skin.force),
-            hand_force_reference: config.tasks.hand_force.force_signal_desired,
+            hand_force_reference_n: config.tasks.hand_force.force_desired_n,
+            force: config.skin.force.prepared(),
+            hand_map: HandForceMap::new(&config),
             base_reference: None,
             supervisor,
             config,
@@ -215,17 +225,19 @@ impl Controller {
         self.goal.as_ref()
     }
 
-    /// Sets the desired fused hand signal `f_c,d` of interactive-force-control paper eq. (9): the hand patches' summed
-    /// virtual force along the hand's z axis (eq. 7: a sum over the active cells, so up to the
-    /// number of hand cells), clamped to `[0, hand cells]`; NaN is refused.
-    pub fn set_hand_force_reference(&mut self, signal: f64) -> Result<(), Fault> {
-        if signal.is_nan() {
+    /// Sets the desired hand contact force \[N\] along the hand's z axis, clamped to
+    /// `[0, hand cells × max_n]` (what the hand can sense, each cell up to the saturation of the
+    /// force characteristic); NaN is refused. Each cycle reads it as the signal `f_c,d` of
+    /// interactive-force-control paper eq. (9) with the contact's measured distribution over
+    /// the hand cells (`skin::measured`; an even press of the palm while nothing presses).
+    pub fn set_hand_force_reference(&mut self, force_n: f64) -> Result<(), Fault> {
+        if force_n.is_nan() {
             return Err(Fault::NonFinite { input: "hand force reference", index: 0 });
         }
         let layout = &self.config.layout;
         let hand_cells: usize =
             layout.patches().iter().zip(&self.hand_patches).filter(|(_, &h)| h).map(|(p, _)| p.cells.len()).sum();
-        self.hand_force_reference = signal.clamp(0.0, hand_cells as f64);
+        self.hand_force_reference_n = force_n.clamp(0.0, hand_cells as f64 * self.config.skin.force.max_n);
         Ok(())
     }
 
@@ -400,8 +412,7 @@ impl Controller {
         let (hand, guidance) = (&self.hand_patches, &self.guidance_patches);
         patch_poses_world(layout, |f| data.frame_pose(f), |j| hand[j] || guidance[j], &mut self.patch_poses);
 
-        let mut hand = self.hand_signals();
-        hand.force_reference = self.hand_force_reference;
+        let hand = self.hand_signals();
         self.output.hand_moment = data.frame_pose(self.ee).rotation.inverse_transform_vector(&hand.moment_world);
         self.clock.lap(Stage::Skin);
 
@@ -504,13 +515,20 @@ impl Controller {
         })
     }
 
-    /// Interactive-force-control paper eq. (9)-(11) inputs from the patch wrenches of this cycle.
+    /// Interactive-force-control paper eq. (9)-(11) inputs from the patch wrenches of this cycle
+    /// (eq. 9's `f_c,d`: the force reference read with the contact's measured distribution).
     fn hand_signals(&self) -> HandSignals {
         let hand_pose = self.data.frame_pose(self.ee);
         let (poses, wrenches) = (&self.patch_poses, &self.wrenches);
         let in_hand = sum_patch_forces_in_frame(hand_pose, poses, wrenches, |j| self.hand_patches[j]);
+        let (layout, fusion, reference_n) = (&self.config.layout, &self.fusion, self.hand_force_reference_n);
+        let z_hand = hand_pose.rotation * nalgebra::Vector3::z();
+        let hand = |j: usize| self.hand_patches[j];
+        let contact = measured_contact(layout, &self.live, &self.force, fusion, &z_hand, poses, hand, reference_n);
+        let even_press = self.hand_map.as_ref().map_or(0.0, |m| m.signal(reference_n));
         let mut s = HandSignals {
             fused_force: in_hand.z,
+            force_reference: contact.reference_signal.unwrap_or(even_press),
             guidance_force: sum_patch_forces_in_frame(hand_pose, poses, wrenches, |j| self.guidance_patches[j]),
             ..HandSignals::default()
         };

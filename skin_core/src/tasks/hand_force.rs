@@ -4,7 +4,9 @@
 //! to be touched. The row is the third row of the hand body Jacobian, `z_hᵀ J_v(o_h)` (world
 //! `z_h` from the frame pose), and
 //! `ẍ* = (K_1 Δ − D_1 ż_h) / Λ_1` (eq. 9) with
-//! - force mode (contact phase): `Δ = f_c,d − f_c` on the fused hand-patch signal `f_c`;
+//! - force mode (contact phase): `Δ = f_c,d − f_c` on the fused hand-patch signal `f_c`, the
+//!   reference `f_c,d` the force in newtons read through the characteristic with the contact's
+//!   measured distribution over the cells (`skin::measured`);
 //! - distance mode (approach phase): `Δ = d_p − d_p,d` with `d_p` from the proximity signal
 //!   through the inverse characteristic.
 //!
@@ -60,20 +62,22 @@ pub struct HandForce {
     pub frame: usize,
     /// Gains and set points.
     pub params: HandForceParams,
+    /// `f_c,d` of eq. (9) in signal units (the cycle's [`crate::tasks::HandSignals::force_reference`]).
+    pub force_signal_desired: f64,
     rows: PointRows,
 }
 
 impl HandForce {
     /// The task for `frame` on a model with `nv` joints; its level needs 1 row.
     pub fn new(nv: usize, frame: usize, params: HandForceParams) -> Self {
-        Self { frame, params, rows: PointRows::new(nv) }
+        Self { frame, params, force_signal_desired: 0.0, rows: PointRows::new(nv) }
     }
 
     /// The error `Δ` of eq. (9) for a measurement (positive: push along `+z_h`).
     pub fn error(&self, measurement: HandMeasurement, proximity: &ProximityCharacteristic) -> f64 {
         match measurement {
             HandMeasurement::Force { fused_signal } => {
-                self.params.k_force_n_per_signal * (self.params.force_signal_desired - fused_signal)
+                self.params.k_force_n_per_signal * (self.force_signal_desired - fused_signal)
             }
             HandMeasurement::Distance { proximity_signal } => {
                 self.params.k_distance_n_per_m
@@ -129,7 +133,7 @@ impl Task for HandForce {
 
     /// Eq. (9) on the fused hand signal toward the reference of this cycle.
     fn fill(&mut self, cx: &Cycle, level: &mut TaskLevel) -> Result<(), TaskError> {
-        self.params.force_signal_desired = cx.hand.force_reference;
+        self.force_signal_desired = cx.hand.force_reference;
         let m = HandMeasurement::Force { fused_signal: cx.hand.fused_force };
         self.update(cx.model, cx.data, m, cx.hand.proximity, &cx.skin.proximity, level).map(drop)
     }

@@ -66,9 +66,10 @@ declare_params! {
         pub k_distance_n_per_m: f64 => { unit: "N/m", range: Range::closed(0.0, 1e4), live: false },
         /// `D_1`.
         pub d_n_s_per_m: f64 => { unit: "N s/m", range: Range::closed(0.0, 1e4), live: false },
-        /// Desired fused contact signal `f_c,d` (contact phase, Table 1): the hand patch's summed
-        /// virtual force (eq. 7 sums the active cells' signals, so it can exceed 1).
-        pub force_signal_desired: f64 => { unit: "signal", range: Range::closed(0.0, 1e4), live: false },
+        /// Desired contact force (contact phase, Table 1) until a reference is given; the
+        /// controller turns it into the signal `f_c,d` of eq. (9) with the measured distribution
+        /// of the contact over the hand cells (`skin::measured`).
+        pub force_desired_n: f64 => { unit: "N", range: Range::closed(0.0, 1e3), live: false },
         /// Desired distance `d_p,d` (approach phase, Table 1).
         pub distance_desired_m: f64 => { unit: "m", range: Range::closed(0.0, 1.0), live: false },
         /// Approach speed bound: the hand may close on a sensed surface at most at

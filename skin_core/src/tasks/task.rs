@@ -96,7 +96,9 @@ pub struct HandSignals {
     pub moment_world: Vector3<f64>,
     /// Guidance patches' summed force in the hand frame (eq. 11's `h_F`).
     pub guidance_force: Vector3<f64>,
-    /// Desired fused signal `f_c,d` of eq. (9) (signal units).
+    /// Desired fused signal `f_c,d` of eq. (9) (signal units): the controller's force
+    /// reference in newtons read through the characteristic with the contact's measured
+    /// distribution over the hand cells (`skin::measured`).
     pub force_reference: f64,
 }
 

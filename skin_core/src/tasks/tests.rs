@@ -239,6 +239,7 @@ fn hand_approach_speed_is_bounded_by_the_sensed_distance() {
     // undamped eq. (9), so that only the bound can brake
     let h = HandForceParams { d_n_s_per_m: 0.0, ..s.params.hand_force };
     let mut task = HandForce::new(s.model.nv(), hand, h);
+    task.force_signal_desired = 0.3;
     let mut level = TaskLevel::new("hand", s.model.nv(), 1);
     let mut j = Matrix6xX::zeros(s.model.nv());
     point_jacobian(&s.model, &s.data, hand, &Vector3::zeros(), &mut j).unwrap();
@@ -258,7 +259,7 @@ fn hand_approach_speed_is_bounded_by_the_sensed_distance() {
     assert_relative_eq!(xdd, -limit_near / super::hand_force::APPROACH_BRAKE_S, max_relative = 1e-6);
     // the same speed with nothing in range is below the bound: eq. (9) as it is
     let xdd = task.update(&s.model, &s.data, far, 0.0, &s.skin.proximity, &mut level).unwrap();
-    assert_relative_eq!(xdd, h.k_force_n_per_signal * h.force_signal_desired / h.lambda_kg, max_relative = 1e-6);
+    assert_relative_eq!(xdd, h.k_force_n_per_signal * task.force_signal_desired / h.lambda_kg, max_relative = 1e-6);
     // retreating is never bounded
     let qd = moving(-0.2);
     update_kinematics(&s.model, &mut s.data, &s.q, qd.as_slice()).unwrap();
@@ -271,6 +272,7 @@ fn hand_force_sign_and_row() {
     let s = tomm();
     let hand = s.model.frame_index("right_hand").unwrap();
     let mut task = HandForce::new(s.model.nv(), hand, s.params.hand_force);
+    task.force_signal_desired = 0.3;
     let mut level = TaskLevel::new("hand", s.model.nv(), 1);
     // force below the reference: accelerate into the surface (+z_h)
     let xdd = task
@@ -278,7 +280,7 @@ fn hand_force_sign_and_row() {
         .unwrap();
     assert!(xdd > 0.0);
     let h = s.params.hand_force;
-    assert_relative_eq!(xdd, h.k_force_n_per_signal * h.force_signal_desired / h.lambda_kg, epsilon = 1e-12);
+    assert_relative_eq!(xdd, h.k_force_n_per_signal * task.force_signal_desired / h.lambda_kg, epsilon = 1e-12);
     // too much force: back off
     let xdd = task
         .update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.9 }, 0.0, &s.skin.proximity, &mut level)

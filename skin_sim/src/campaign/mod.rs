@@ -281,7 +281,7 @@ pub fn robustness_md(results: &[SceneResult], s: &Summary) -> String {
         classes.dedup();
         md += &format!("| {} | {} | {} | {} |\n", f.name, rows.len(), failing.len(), classes.join(", "));
     }
-    md += "\n## Failing scenes\n\nRerun one with `skin_sim campaign --seed <seed> --only <id>` (outputs in `out/campaign/<id>/`).\n\n";
+    md += "\n## Failing scenes\n\nRerun one with `skin_sim campaign --seed <seed> --only <id>` (outputs in `out/campaign/<id>/`), one family with `--family <name>`.\n\n";
     let mut any = false;
     for r in results {
         let f = failures(r);

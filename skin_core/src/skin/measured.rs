@@ -33,6 +33,7 @@ use super::live::LiveCells;
 /// selects: `c_i` the cell's outward normal along `axis` (world coordinates), `F_i` its newtons.
 /// `patch_poses` as from [`super::transforms::patch_poses_world`] (those of the included patches
 /// up to date).
+#[allow(clippy::too_many_arguments)]
 fn pressed_cells(
     layout: &ResolvedLayout,
     live: &LiveCells,

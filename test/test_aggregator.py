@@ -277,7 +277,7 @@ def test_skin_aggregator(spawn, rclpy_node):
 
 
 def test_round_trip_latency(spawn, rclpy_node):
-    """Ping-pong: all 718 TOMM cells in, the patches back, one message at a time. Prints the
+    """Ping-pong: all TOMM cells in, the patches back, one message at a time. Prints the
     round-trip figures (rclpy publish -> r2r node -> rclpy callback) and the node's own
     aggregation time; asserts only that every message is answered, in order."""
     layout = Layout(LAYOUT)

@@ -85,7 +85,7 @@ class Peer:
 
 def test_controller_graph(spawn, rclpy_node):
     from geometry_msgs.msg import PoseStamped
-    from rcl_interfaces.srv import GetParameters, ListParameters
+    from rcl_interfaces.srv import DescribeParameters, GetParameters, ListParameters
     from skin_msgs.srv import SetPhase
 
     layout = yaml.safe_load((TOP / "config" / "skin" / "tomm.yaml").read_text())
@@ -146,7 +146,16 @@ def test_controller_graph(spawn, rclpy_node):
     ok = peer.set_param("input_timeout_s", 0.2)
     assert ok.successful, ok.reason
     bad = peer.set_param("input_timeout_s", -1.0)
-    assert not bad.successful and "input_timeout_s" in bad.reason, bad.reason
+    assert not bad.successful and "input_timeout_s" in bad.reason and "[0.001, 1] s" in bad.reason, bad.reason
+    # Descriptions come from the declarations (declare_params!): unit, range, when it applies.
+    desc = peer.call(DescribeParameters, "/task_controller/describe_parameters",
+                     DescribeParameters.Request(names=["input_timeout_s", "control_rate_hz", "tasks.goal.kp_n_per_m"]))
+    texts = [d.description for d in desc.descriptors]
+    assert "[s], in [0.001, 1] (settable)" in texts[0], texts
+    assert "[Hz], in (0, 10000] (start only)" in texts[1], texts
+    assert "(start only)" in texts[2], texts
+    ro_rate = peer.set_param("control_rate_hz", 250.0)
+    assert not ro_rate.successful and "read-only" in ro_rate.reason, ro_rate.reason
     ro = peer.set_param("tasks.goal.kp_n_per_m", 10.0)
     assert not ro.successful and "read-only" in ro.reason, ro.reason
 

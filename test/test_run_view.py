@@ -1,6 +1,6 @@
 """What a viewer gets from a run: `run.mcap` as Foxglove and RViz read it, and the rendered frames.
 
-One `skin_sim run` of intentional_contact (10 s: the arm is pushing the obstacle by then) is read
+One `skin_sim run` of intentional_contact (13 s: the arm pushes the obstacle from about 10 s on, after the stuck switch near 9 s) is read
 back with the `mcap` library and its ROS 2 decoder (`mcap-ros2-support`, Foxglove's Python stack)
 and with rosbags, as outside peers:
 - `/tf` forms one tree under `odom`; every link pose it gives agrees with pinocchio's forward
@@ -27,7 +27,7 @@ from conftest import TOP, binary
 os.environ.setdefault("MUJOCO_GL", "egl")
 sys.path.insert(0, str(TOP / "scripts"))
 
-DURATION_S = 10.0
+DURATION_S = 13.0
 
 
 @pytest.fixture(scope="module")
@@ -198,7 +198,7 @@ def test_the_pressed_cells_colour_is_where_the_cell_is(run_dir):
     _, frame, shown = best
     pressed = [(m, p, c) for m in shown.values() if m["shape"] == "sphere_list"
                for p, c in zip(m["points"], m["colors"]) if c[0] > 0.3]
-    assert pressed, "intentional_contact presses the arm on the obstacle by 10 s"
+    assert pressed, "intentional_contact presses the arm on the obstacle by 13 s"
     cells_only = {k: m for k, m in shown.items() if m["shape"] == "sphere_list"}
     painter = rk.Painter(run_dir, view, rk.WIDTH, rk.HEIGHT)
     try:

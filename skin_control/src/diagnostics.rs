@@ -11,8 +11,8 @@ use r2r::diagnostic_msgs::msg::{DiagnosticArray, DiagnosticStatus, KeyValue};
 use r2r::std_msgs::msg::Header;
 
 use crate::input_health::{fresh, IssueTable, StampIssue};
-use crate::nodes::Timing;
 use crate::task_controller::InputAge;
+use crate::timing::Timing;
 
 /// The topic (global, as diagnostic_updater's).
 pub const TOPIC: &str = "/diagnostics";

@@ -1,8 +1,9 @@
 //! skin_control: the ROS 2 (Jazzy) layer of the system. Nodes are thin: messages are converted to
 //! `skin_core` types in one place ([`convert`]), then the control law in `skin_core` does the work.
-//! The nodes' work without ROS is in [`aggregator`], [`task_controller`] and [`supervisor_node`];
-//! their wiring in [`nodes`]; the bag tool `skin_bag` in [`rosbag`]; the `skin_watchdog`'s
-//! decision in [`watchdog`], the controller's heartbeat in [`heartbeat`]. This is the robot
+//! One naming scheme for every node: its work without ROS is the module named for what it does
+//! ([`aggregator`], [`task_controller`], [`priority_supervisor`], [`watchdog`]), its ROS wiring
+//! is `nodes::<executable>` ([`nodes`]), and `bin/<executable>.rs` only runs it. The bag tool
+//! `skin_bag` is in [`rosbag`], the controller's heartbeat in [`heartbeat`]. This is the robot
 //! package: it never links MuJoCo (the simulation nodes are the `skin_sim_ros` package).
 #![warn(missing_docs)]
 
@@ -15,12 +16,14 @@ pub mod lifecycle;
 pub mod markers;
 pub mod nodes;
 pub mod paths;
+pub mod priority_supervisor;
 pub mod qos;
 pub mod robot_description;
 pub mod ros_params;
 pub mod rosbag;
 pub mod shutdown;
-pub mod supervisor_node;
 pub mod task_controller;
 pub mod tf;
+pub mod timing;
+pub mod topics;
 pub mod watchdog;

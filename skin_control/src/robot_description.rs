@@ -4,12 +4,12 @@
 //!
 //! robot_state_publisher sees a mobile robot rooted at its base frame: TF gets the base's pose
 //! from the base driver's `odom -> base_link` (REP 105). The controller models that pose with
-//! three virtual joints (`skin_core::resolver::BASE_JOINTS`: prismatic x, prismatic y, revolute
+//! three virtual joints (`skin_core::model::BASE_JOINTS`: prismatic x, prismatic y, revolute
 //! yaw from the root `world`); [`mount_on_planar_base`] puts them back under such a URDF.
 use std::path::Path;
 
 use skin_core::model::RobotModel;
-use skin_core::resolver::BASE_JOINTS;
+use skin_core::model::BASE_JOINTS;
 
 /// The topic (relative in the node's namespace, as robot_state_publisher's).
 pub const TOPIC: &str = "/robot_description";

@@ -69,30 +69,24 @@ pub struct StructParams<T> {
     value: T,
     flat: IndexMap<String, ParameterValue>,
     validate: Validate<T>,
-    descriptions: &'static [(&'static str, &'static str)],
     /// Descriptions from declarations (`skin_core::param_file::declare`), by dotted key.
     declared: IndexMap<String, &'static str>,
     read_only: IndexMap<String, (ParameterValue, &'static str)>,
-    start_only: &'static [&'static str],
+    /// Keys (or sections, ending in `.`) that only the start reads.
+    start_only: Vec<String>,
 }
 
 impl<T: Serialize + DeserializeOwned> StructParams<T> {
-    /// Serves `value` (validated with `validate`); `descriptions` maps dotted keys to the text
-    /// that `ros2 param describe` shows.
-    pub fn new(
-        value: T,
-        validate: Validate<T>,
-        descriptions: &'static [(&'static str, &'static str)],
-    ) -> Result<Self, ParamError> {
+    /// Serves `value` (validated with `validate`); [`Self::with_specs`] describes its keys.
+    pub fn new(value: T, validate: Validate<T>) -> Result<Self, ParamError> {
         validate(&value).map_err(|reason| ParamError::new("", reason))?;
         Ok(StructParams {
             flat: flatten(&value)?,
             value,
             validate,
-            descriptions,
             declared: IndexMap::new(),
             read_only: IndexMap::new(),
-            start_only: &[],
+            start_only: Vec::new(),
         })
     }
 
@@ -103,8 +97,10 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
     }
 
     /// Describes the keys of declared parameters (`ros2 param describe`: the description, unit,
-    /// range, and whether the node applies a change while it runs).
+    /// range, and whether the node applies a change while it runs); a key declared not `live`
+    /// is read at start only.
     pub fn with_specs(mut self, specs: Vec<ParamSpec>) -> Self {
+        self.start_only.extend(specs.iter().filter(|s| !s.live).map(|s| s.key.clone()));
         for s in specs {
             let unit = if s.unit.is_empty() { String::new() } else { format!(" [{}]", s.unit) };
             let when = if s.live && !self.is_start_only(&s.key) { "settable" } else { "start only" };
@@ -115,15 +111,15 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
         self
     }
 
-    /// Marks struct keys that only the start reads: a key equal to an entry, or under an entry
-    /// that ends with `.` (a section). They take overrides at start; set requests are rejected.
-    pub fn with_start_only(mut self, keys: &'static [&'static str]) -> Self {
-        self.start_only = keys;
+    /// Marks a section (`skin.`) that only this node's start reads, whatever its declarations
+    /// say of other nodes. Start-only keys take overrides at start; set requests are rejected.
+    pub fn with_start_only_section(mut self, section: &str) -> Self {
+        self.start_only.push(section.to_string());
         self
     }
 
     fn is_start_only(&self, key: &str) -> bool {
-        self.start_only.iter().any(|k| key == *k || (k.ends_with('.') && key.starts_with(k)))
+        self.start_only.iter().any(|k| key == k || (k.ends_with('.') && key.starts_with(k.as_str())))
     }
 
     /// The current, valid struct.
@@ -161,8 +157,7 @@ impl<T: Serialize + DeserializeOwned> StructParams<T> {
     }
 
     fn description(&self, key: &str) -> &'static str {
-        let listed = self.descriptions.iter().find(|(k, _)| *k == key).map(|(_, d)| *d);
-        listed.or_else(|| self.declared.get(key).copied()).unwrap_or("")
+        self.declared.get(key).copied().unwrap_or("")
     }
 
     /// Lays the node's parameter overrides (name -> value, as r2r reads them from `--ros-args`)
@@ -329,6 +324,7 @@ fn to_json(key: &str, v: &ParameterValue) -> Result<Value, String> {
 mod tests {
     use super::*;
     use serde::Deserialize;
+    use skin_core::param_file::declare::Declared;
     use skin_core::skin::params::SkinParams;
     use std::path::Path;
 
@@ -337,8 +333,9 @@ mod tests {
     }
 
     fn served() -> StructParams<SkinParams> {
-        StructParams::new(skin_params(), |p| p.validate().map_err(|e| e.to_string()), &[("fusion.weight_force", "w")])
+        StructParams::new(skin_params(), |p| p.validate().map_err(|e| e.to_string()))
             .unwrap()
+            .with_specs(SkinParams::all_specs())
             .with_read_only("layout_file", ParameterValue::String("l.yaml".into()), "layout")
     }
 
@@ -387,7 +384,8 @@ mod tests {
         s.register_parameters("", None, &mut params).unwrap();
         assert_eq!(s.value().fusion.weight_force, 0.75);
         assert_eq!(params["fusion.weight_force"].value, ParameterValue::Double(0.75));
-        assert_eq!(params["fusion.weight_force"].description, "w");
+        let described = params["fusion.weight_force"].description;
+        assert!(described.contains("in [0, 1] (settable)"), "{described}");
         assert_eq!(params["layout_file"].value, ParameterValue::String("l.yaml".into()));
         assert_eq!(params.len(), s.flat().len() + 2);
         assert_eq!(s.get_parameter("layout_file").unwrap(), ParameterValue::String("l.yaml".into()));
@@ -408,7 +406,15 @@ mod tests {
 
     #[test]
     fn start_only_keys_take_overrides_but_refuse_sets() {
-        let mut s = served().with_start_only(&["proximity.", "fusion.weight_force"]);
+        // a section this node reads at start, and a key declared not live
+        let fixed = ParamSpec {
+            key: "fusion.weight_force".into(),
+            unit: "",
+            values: skin_core::param_file::declare::Values::Choices("any"),
+            description: "w".into(),
+            live: false,
+        };
+        let mut s = served().with_start_only_section("proximity.").with_specs(vec![fixed]);
         let mut o = IndexMap::new();
         o.insert("proximity.range_m".to_string(), Parameter::new(ParameterValue::Double(0.2)));
         s.apply_overrides(&o).unwrap();
@@ -438,7 +444,7 @@ mod tests {
             count: 3,
             inner: Inner { gains: [1.0, 2.5], ids: vec![4, 5], names: vec!["a".into()], limit: None },
         };
-        let mut s = StructParams::new(v, |_| Ok(()), &[]).unwrap();
+        let mut s = StructParams::new(v, |_| Ok(())).unwrap();
         assert_eq!(s.flat()["count"], ParameterValue::Integer(3));
         assert_eq!(s.flat()["inner.ids"], ParameterValue::IntegerArray(vec![4, 5]));
         // serde_json writes 1.0 as a float: the array stays a double array.

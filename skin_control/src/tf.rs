@@ -30,7 +30,7 @@ pub struct FrameTransform {
 #[cfg(tf2_msgs)]
 mod imp {
     use super::*;
-    use crate::nodes::topics::{TF, TF_STATIC};
+    use crate::topics::{TF, TF_STATIC};
     use r2r::geometry_msgs::msg::{Quaternion, Transform, TransformStamped, Vector3};
     use r2r::tf2_msgs::msg::TFMessage;
 

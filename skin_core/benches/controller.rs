@@ -3,10 +3,10 @@
 //! the Cholesky inverse of M), the blend and the resolver. Each point's stage shares go to
 //! `out/bench/stages.json` (`support::bench`).
 //!
-//! - `controller_update_tomm`: TOMM (15 DoF), 718 cells aggregated, four task levels (skin
+//! - `controller_update_tomm`: TOMM (15 DoF), its 1082 cells aggregated, four task levels (skin
 //!   avoidance with 12 cells in range, hand distance, wrist, tactile guidance) plus the posture
 //!   torque with body compliance and base avoidance from a 360-point scan.
-//! - `controller_update_planar7`: planar7 (7 DoF), 405 cells, intentional-contact paper Table I (a): avoidance
+//! - `controller_update_planar7`: planar7 (7 DoF), 563 cells, intentional-contact paper Table I (a): avoidance
 //!   (8 cells in range) > goal > contact reaction (2 contact cells).
 //! - `controller_update_humanoid`: the 29-joint humanoid with its generated whole-body skin
 //!   (`support::humanoid_config`, over 3 000 cells), 50 live cells (40 in range over the whole

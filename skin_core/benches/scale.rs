@@ -17,12 +17,11 @@ use skin_core::controller::Controller;
 use skin_core::model::RobotModel;
 use skin_core::skin::generate::{generate_layout, GeneratorSpec, LinkSelection, PatchFrame};
 use skin_core::skin::layout::ResolvedLayout;
-use skin_core::skin::tiling::Face;
 use support::{bench, readings, scan, selected, tomm_config, Point};
 
 /// Cell counts of the cells' series.
 const CELLS: [usize; 4] = [700, 2000, 5000, 10000];
-/// Active cells of the active cells' series (the last one is all 718).
+/// Active cells of the active cells' series (up to 718, two thirds of the shipped layout).
 const ACTIVE: [usize; 8] = [0, 25, 50, 100, 200, 350, 500, 718];
 
 /// TOMM's shipped layout regenerated at `pitch_m` (the `skin_layout` command of
@@ -30,16 +29,15 @@ const ACTIVE: [usize; 8] = [0, 25, 50, 100, 200, 350, 500, 718];
 fn tomm_layout(model: &RobotModel, pitch_m: f64) -> ResolvedLayout {
     let mut links = Vec::new();
     for side in ["left", "right"] {
-        for link in ["upper_arm_link:0", "forearm_link:0", "wrist_1_link", "wrist_2_link", "wrist_3_link", "palm"] {
+        for link in ["upper_arm_link", "forearm_link", "wrist_1_link", "wrist_2_link", "wrist_3_link", "palm"] {
             links.push(format!("{side}_{link}").parse::<LinkSelection>().unwrap());
         }
     }
-    let palm = vec![Face::PosZ, Face::PosX, Face::NegX, Face::PosY, Face::NegY];
     let spec = GeneratorSpec {
         links,
         pitch_m,
-        faces: vec![("left_palm".into(), palm.clone()), ("right_palm".into(), palm)],
-        spheres: false,
+        spheres: true,
+        caps: true,
         patch_frame: PatchFrame::Primitive,
         ..Default::default()
     };

@@ -749,3 +749,32 @@ fn hierarchy_locked_joints_solve_the_free_joints_exactly() {
     let err = (tau.rows(3, n - 3) - &want).amax() / want.amax();
     assert!(err < 1e-9, "relative difference to the reduced hierarchy {err:e}");
 }
+
+/// The projection leak (docs/controller.md, `hierarchy_dynamics`): the resolver executes a
+/// torque as `C_a q̇ = τ* − g` (steady velocity of eq. 26) with `C_a ∝ M_a`. A force level below
+/// the intentional-contact goal, projected with the model's `M(q)`, moves the goal point in that
+/// executed motion; projected with the resolver's inertia `M_a` (`admittance_inertia`) it does not.
+#[test]
+fn a_lower_force_level_moves_the_goal_only_when_projected_with_another_inertia_than_executed() {
+    let s = State::new("planar7.urdf", &P7_BENT, &P7_QD);
+    let n = 7;
+    let (j1, _) = s.task("ee", [0.0; 3], &XY);
+    let mut goal = TaskLevel::new("goal", n, 2);
+    goal.set(&j1, Reference::Force { f: &[3.0, -2.0] }).unwrap();
+    let (jc, _) = s.point("link3", [0.15, 0.02, 0.0]);
+    let mut contact = TaskLevel::new("contact_reaction", n, 4);
+    contact.push_directional(&[0.0, -1.0, 0.0], &jc.rows(0, 3), Reference::Force { f: &[10.0] }).unwrap();
+    let damping = 10.0; // C_a, and M_a = C_a / 20 as in config/resolver.yaml
+    let m_a = DMatrix::identity(n, n) * (damping / 20.0);
+    // the goal point's steady velocity J_1 C_a⁻¹ τ due to the lower level alone
+    let leak = |m: &DMatrix<f64>| {
+        let mut solver = HierarchySolver::new(n, 2, 4, InverseParams::default()).unwrap();
+        let (mut both, mut top) = (DVector::zeros(n), DVector::zeros(n));
+        solver.solve(m, [&goal, &contact], None, None, &mut both).unwrap();
+        solver.solve(m, [&goal], None, None, &mut top).unwrap();
+        (&j1 * (both - top) / damping).norm()
+    };
+    let goal_speed = (&j1 * j1.transpose() * DVector::from_column_slice(&[3.0, -2.0]) / damping).norm();
+    assert!(leak(&s.m) > 0.05 * goal_speed, "with M(q): {} vs {goal_speed} m/s", leak(&s.m));
+    assert!(leak(&m_a) < 1e-9 * goal_speed, "with M_a: {} m/s", leak(&m_a));
+}

@@ -4,11 +4,11 @@
 use skin_core::controller::HandForceMap;
 use skin_core::model::{update_kinematics, ModelData};
 use skin_core::supervisor::Mode;
-use skin_sim::runner::RunTarget;
-use skin_sim::scenario::{self, SCENARIOS};
+use skin_sim::run::runner::RunTarget;
+use skin_sim::run::scenario::{self, SCENARIOS};
 use skin_sim::scene::RunOverrides;
 
-fn run(name: &str, seconds: f64) -> skin_sim::report::RunReport {
+fn run(name: &str, seconds: f64) -> skin_sim::outputs::report::RunReport {
     let target = RunTarget::from(scenario::find(name).expect("a scenario"));
     let overrides = RunOverrides { duration_s: Some(seconds), ..RunOverrides::default() };
     target.run(&overrides, |_| {}).unwrap_or_else(|e| panic!("{name}: {e}"))
@@ -107,7 +107,7 @@ fn tomm_fixed_obstacle_passes_every_outcome_check() {
 /// Runs an intentional-contact paper scene and asserts its story: stuck first ((a) -> (b)), the arm touches the
 /// obstacle in (b) with at most eps_c, and every outcome check (goal within 1 cm, contacts at
 /// most eps_c outside the pushes, pushes relieved) passes.
-fn passes_paper_000_checks(name: &str, seconds: f64) -> skin_sim::report::RunReport {
+fn passes_paper_000_checks(name: &str, seconds: f64) -> skin_sim::outputs::report::RunReport {
     let report = run(name, seconds);
     let modes: Vec<_> = report.record.switches.iter().map(|s| (s.from, s.to)).collect();
     assert!(

@@ -3,10 +3,10 @@
 
 use skin_bag::msgs::{Arrangement, Float64MultiArray, JointState, MarkerArray, StringMsg, TfMessage};
 use skin_bag::read_bag;
-use skin_sim::outputs::{FigurePng, KeyFrames, RunBag};
-use skin_sim::report::{write_all, RunOutput};
-use skin_sim::runner::RunTarget;
-use skin_sim::scenario;
+use skin_sim::outputs::artifacts::{FigurePng, KeyFrames, RunBag};
+use skin_sim::outputs::report::{write_all, RunOutput};
+use skin_sim::run::runner::RunTarget;
+use skin_sim::run::scenario;
 use skin_sim::scene::RunOverrides;
 
 #[test]

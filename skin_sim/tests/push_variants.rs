@@ -2,16 +2,16 @@
 //! shipped `intentional_contact` scene, generated here (not shipped scene files): the obstacle
 //! fixed, heavier (1-1.5 kg) or too heavy to slide under eps_c (2 and 3 kg: friction 3.9 /
 //! 5.9 N plus the push to start it), or moved by 5-10 cm. Every run must be safe by the shared definition
-//! (`skin_sim::safety::violations`: no non-finite command, safe-stop, joint over its velocity
+//! (`skin_sim::outputs::safety::violations`: no non-finite command, safe-stop, joint over its velocity
 //! limit, contact over eps_c for more than 0.5 s in one event, chatter) and end `reached` or
 //! `blocked`; the fixed obstacle must end `blocked` after a single (b) -> (c).
 
 use skin_core::supervisor::Mode;
-use skin_sim::outcome;
-use skin_sim::report::RunReport;
-use skin_sim::runner::RunTarget;
-use skin_sim::safety;
-use skin_sim::scenario;
+use skin_sim::outputs::outcome;
+use skin_sim::outputs::report::RunReport;
+use skin_sim::outputs::safety;
+use skin_sim::run::runner::RunTarget;
+use skin_sim::run::scenario;
 use skin_sim::scene::spec::ExpectSpec;
 use skin_sim::Scene;
 
@@ -45,14 +45,17 @@ fn hard_contacts_from_b(r: &RunReport) -> usize {
 }
 
 #[test]
-fn a_fixed_obstacle_is_pushed_once_then_the_arm_holds_blocked() {
+fn a_fixed_obstacle_is_pushed_at_most_twice_then_the_arm_holds_blocked() {
     let r = run_variant(|s| {
         s.spec.objects[0].mass_kg = None; // welded to the world
         s.spec.pushes.clear(); // a push needs a movable object
     });
     assert_safe("fixed", &r);
     assert_eq!(outcome(&r), "blocked", "switches {:?}", r.record.switches);
-    assert_eq!(hard_contacts_from_b(&r), 1, "one push, no (b) <-> (c) cycle: {:?}", r.record.switches);
+    // The first push's progress includes its approach, so it may be retried once; a retry
+    // within `retry_interval_s` of a hard contact is never made (docs/supervisor.md).
+    let n = hard_contacts_from_b(&r);
+    assert!((1..=2).contains(&n), "at most two pushes, no (b) <-> (c) cycle: {:?}", r.record.switches);
     let last = r.record.cycles.last().unwrap();
     assert_eq!(last.mode, Mode::Avoidance, "held in (a)");
     // Settled: once held (and the blend and back-off of the first second are over), the arm
@@ -73,13 +76,13 @@ fn a_fixed_obstacle_is_pushed_once_then_the_arm_holds_blocked() {
 }
 
 /// 1-1.5 kg slide under eps_c once moving (friction 2-2.9 N) and 2-3 kg do not; every one ends
-/// safe, with at most one push that reaches eps_c.
+/// safe, with at most two pushes that reach eps_c (a retry of a push that made progress).
 #[test]
 fn heavier_obstacles_end_safely() {
     for kg in [1.0, 1.5, 2.0, 3.0] {
         let r = run_variant(|s| s.spec.objects[0].mass_kg = Some(kg));
         assert_safe(&format!("{kg} kg"), &r);
-        assert!(hard_contacts_from_b(&r) <= 1, "{kg} kg: {:?}", r.record.switches);
+        assert!(hard_contacts_from_b(&r) <= 2, "{kg} kg: {:?}", r.record.switches);
     }
 }
 
@@ -104,7 +107,7 @@ fn the_shipped_movable_obstacle_is_still_pushed_to_the_goal() {
 /// A controller setup in `dir` that is the shipped planar7 one with `contact_reaction` removed
 /// from the three Table I arrangements.
 fn setup_without_contact_reaction(dir: &std::path::Path) -> std::path::PathBuf {
-    let config = scenario::config_dir();
+    let config = skin_sim::scene::config_dir();
     let shipped = std::fs::read_to_string(config.join("supervisor.yaml")).unwrap();
     let mut supervisor = shipped.clone();
     for (from, to) in [
@@ -134,8 +137,8 @@ fn setup_without_contact_reaction(dir: &std::path::Path) -> std::path::PathBuf {
 /// hard contact short; without it the goal keeps pushing into the fixed obstacle.
 #[test]
 fn removing_contact_reaction_fails_the_fixed_obstacle_scene() {
-    let scene = scenario::config_dir().join("scenes/intentional_contact_fixed_obstacle.yaml");
-    let planar7 = scenario::config_dir().join("controller/planar7.yaml");
+    let scene = skin_sim::scene::config_dir().join("scenes/intentional_contact_fixed_obstacle.yaml");
+    let planar7 = skin_sim::scene::config_dir().join("controller/planar7.yaml");
     let with = RunTarget::resolve(scene.to_str().unwrap(), Some(planar7)).unwrap();
     let report = with.run(&Default::default(), |_| {}).unwrap();
     for c in &report.checks {

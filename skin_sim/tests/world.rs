@@ -5,7 +5,7 @@ mod common;
 use common::{planar7, run, scene, scenes_dir, tomm_right_and_base, world};
 use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::MjtGeomBase;
-use skin_sim::mjcf::ROBOT_GROUP;
+use skin_sim::world::mjcf::ROBOT_GROUP;
 use skin_sim::{Scene, SceneError, World};
 
 fn actuators(w: &World) -> usize {

@@ -11,8 +11,8 @@ use anyhow::{Context as _, Result};
 use clap::Parser;
 use skin_control::task_controller::{SupervisorSource, TaskController, TaskControllerParams, Trigger};
 use skin_core::controller::ControllerConfig;
-use skin_sim::closed_loop::ClosedLoop;
-use skin_sim::runner::RunTarget;
+use skin_sim::run::closed_loop::ClosedLoop;
+use skin_sim::run::runner::RunTarget;
 use skin_sim::scene::Scene;
 use skin_sim_ros::sim_bridge::{run_in_process, SimBridge};
 

@@ -17,8 +17,8 @@
 //!
 //! With `--out DIR` (lockstep) a period also waits for the controller's `/controller/state`
 //! answering it, and the run is recorded as `skin_sim run` records it
-//! ([`skin_sim::runner::ExternalRun`]: the world, the commands, the published state): the same
-//! report, outcome checks and files (`skin_sim::outputs::ALL`) are written at the end.
+//! ([`skin_sim::run::runner::ExternalRun`]: the world, the commands, the published state): the same
+//! report, outcome checks and files (`skin_sim::outputs::artifacts::ALL`) are written at the end.
 use std::cell::RefCell;
 use std::path::PathBuf;
 use std::rc::Rc;
@@ -34,14 +34,14 @@ use r2r::rosgraph_msgs::msg::Clock;
 use r2r::sensor_msgs::msg::{JointState, LaserScan};
 use r2r::skin_msgs::msg::{Arrangement, ControllerState, SkinCellArray};
 use r2r::std_msgs::msg::{Float64, Float64MultiArray};
-use skin_sim::runner::{ExternalRun, RunTarget};
+use skin_sim::run::runner::{ExternalRun, RunTarget};
 
 use skin_control::convert::robot::time_msg;
-use skin_control::nodes::topics::*;
 use skin_control::nodes::{local, Pass};
 use skin_control::qos;
 use skin_control::task_controller::ArmsParams;
 use skin_control::tf::{FrameTransform, TfPublisher, BASE_FRAME, ODOM_FRAME, WORLD_FRAME};
+use skin_control::topics::*;
 
 use crate::sim_bridge::{decision, AppliedCommand, SimBridge, SimMessages};
 
@@ -129,7 +129,7 @@ pub fn describe(scene: &str, setup: Option<PathBuf>) -> Result<serde_json::Value
         "urdf": absolute(&setup.urdf.map_or_else(|| scene_dir.join(&loaded.spec.robot.urdf), |u| dir.join(u))),
         "layout": absolute(&dir.join(&setup.skin_layout)),
         "lidar": loaded.spec.lidar.is_some(),
-        "base": skin_control::convert::robot::base_joints(&loaded.model).is_some(),
+        "base": loaded.model.planar_base().is_some(),
         "arms": {"namespaces": arms.namespaces, "joint_prefixes": arms.joint_prefixes},
     }))
 }
@@ -345,7 +345,7 @@ impl SimHandle {
         Ok(())
     }
 
-    /// Wall time since the run started \[s\] (0 before it).
+    /// Wall time since the run started [s] (0 before it).
     fn run_wall_s(&self) -> f64 {
         self.running.map_or(0.0, |r| r.elapsed().as_secs_f64())
     }
@@ -452,7 +452,7 @@ impl SimHandle {
 fn write_report(r: Recorder, world: &skin_sim::World) -> Result<bool> {
     anyhow::ensure!(r.run.cycles() > 0, "--out {}: no control period was completed", r.dir.display());
     let report = r.run.finish(world);
-    let files = skin_sim::report::write_all(&report, &r.dir, &skin_sim::outputs::ALL)?;
+    let files = skin_sim::outputs::report::write_all(&report, &r.dir, &skin_sim::outputs::artifacts::ALL)?;
     print!("{}", report.summary());
     let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
     println!("  wrote {}", names.join(", "));

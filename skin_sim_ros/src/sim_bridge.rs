@@ -17,12 +17,12 @@ use serde::Serialize;
 use skin_core::skin::layout::ResolvedLayout;
 use skin_core::skin::signals::CellReading;
 use skin_core::supervisor::Mode;
-use skin_sim::runner::Decision;
+use skin_sim::run::runner::Decision;
 use skin_sim::scene::Scene;
 use skin_sim::world::World;
 
 use skin_control::convert::control::{read_arm_command, split_arms, supervisor_input, twist_of, ArmCommand};
-use skin_control::convert::robot::{base_joints, time_msg, write_goal, write_joint_state, write_odometry, BaseState};
+use skin_control::convert::robot::{time_msg, write_goal, write_joint_state, write_odometry, BaseState};
 use skin_control::convert::write_cell_array;
 use skin_control::tf::{BASE_FRAME, ODOM_FRAME, WORLD_FRAME};
 
@@ -109,20 +109,11 @@ impl SimBridge {
         let spec = scene.spec.clone();
         let world = World::from_scene(scene).map_err(|e| e.to_string())?;
         let model = &world.scene().model;
-        let base = base_joints(model);
-        let indices: Vec<usize> = (0..model.nv()).filter(|j| !base.is_some_and(|b| b.contains(j))).collect();
+        let indices = world.arm_joints().to_vec();
         let names = indices.iter().map(|&j| model.joint_names()[j].clone()).collect();
         let arms = split_arms(model.joint_names(), world.arm_joints(), namespaces, prefixes)?;
         let scan_geometry = spec.lidar.as_ref().map(|l| {
-            let fov = l.fov_deg.to_radians();
-            let step = if l.rays == 1 {
-                0.0
-            } else if l.fov_deg >= 360.0 {
-                fov / l.rays as f64
-            } else {
-                fov / (l.rays - 1) as f64
-            };
-            let first = if l.rays == 1 { 0.0 } else { -fov / 2.0 };
+            let (first, step) = l.fan();
             (l.frame.clone(), first as f32, step as f32, l.range_m as f32)
         });
         let mut goals: Vec<_> = spec
@@ -142,7 +133,7 @@ impl SimBridge {
             twist: [0.0; 3],
             names,
             indices,
-            base,
+            base: model.planar_base(),
             arms,
             scan_geometry,
             goals,
@@ -260,7 +251,7 @@ impl SimBridge {
 
     /// The base twist command (held until the next one).
     pub fn on_twist(&mut self, msg: &Twist) -> Result<(), String> {
-        self.twist = twist_of(msg).map_err(|e| format!("{}: {e}", skin_control::nodes::topics::CMD_VEL))?;
+        self.twist = twist_of(msg).map_err(|e| format!("{}: {e}", skin_control::topics::CMD_VEL))?;
         Ok(())
     }
 
@@ -350,8 +341,8 @@ mod tests {
     use skin_control::ros_params::flatten;
     use skin_control::task_controller::{SupervisorSource, TaskController, TaskControllerParams, Trigger};
     use skin_core::controller::ControllerConfig;
-    use skin_sim::closed_loop::ClosedLoop;
-    use skin_sim::runner::RunTarget;
+    use skin_sim::run::closed_loop::ClosedLoop;
+    use skin_sim::run::runner::RunTarget;
 
     /// The event-driven cells: all in the first message, then those that read something or
     /// changed (a cell back to zero once), never an unchanged zero one.

@@ -1,5 +1,5 @@
 //! `priority_supervisor`: intentional-contact paper Table I / interactive-force-control paper Table 1 on the ROS graph. Wiring in
-//! `skin_control::nodes::priority_supervisor`, work in `skin_control::supervisor_node`.
+//! `skin_control::nodes::priority_supervisor`, work in `skin_control::priority_supervisor`.
 use std::time::Duration;
 
 use anyhow::{Context as _, Result};

@@ -27,6 +27,9 @@ struct Args {
     wait: nodes::SubscriberWait,
 }
 
+/// How long the node stays on the graph after a lifecycle shutdown.
+const LIFECYCLE_LINGER: std::time::Duration = std::time::Duration::from_secs(1);
+
 fn main() -> Result<()> {
     let args = Args::parse_from(nodes::cli_args());
     shutdown::install().context("installing the SIGINT/SIGTERM handler")?;
@@ -62,6 +65,12 @@ fn main() -> Result<()> {
         node.spin_once(std::time::Duration::from_millis(30));
         handle.send_zeros();
     }
-    node.spin_once(std::time::Duration::from_millis(50));
+    // A lifecycle shutdown's reply is in flight: stay on the graph long enough for a reliable
+    // resend (a reply lost on a loaded host is sent again only while its writer lives).
+    let linger = if handle.finalized() { LIFECYCLE_LINGER } else { std::time::Duration::from_millis(50) };
+    let until = std::time::Instant::now() + linger;
+    while std::time::Instant::now() < until {
+        node.spin_once(std::time::Duration::from_millis(50));
+    }
     Ok(())
 }

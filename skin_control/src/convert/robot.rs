@@ -28,7 +28,6 @@ use r2r::geometry_msgs::msg::{Point, Pose, PoseStamped, Quaternion as Quaternion
 use r2r::nav_msgs::msg::Odometry;
 use r2r::sensor_msgs::msg::{JointState, LaserScan};
 use skin_core::model::RobotModel;
-use skin_core::resolver::BASE_JOINTS;
 
 /// Seconds as a `builtin_interfaces/Time` (rounded to the nanosecond; negative times clamp to 0).
 pub fn time_msg(t_s: f64) -> Time {
@@ -171,7 +170,7 @@ impl StateBuffer {
     /// A buffer for `model`'s joints, all zero and unseen.
     pub fn new(model: &RobotModel) -> Self {
         let n = model.nv();
-        let base = base_joints(model);
+        let base = model.planar_base();
         StateBuffer {
             names: model.joint_names().to_vec(),
             base,
@@ -316,12 +315,6 @@ impl StateBuffer {
     }
 }
 
-/// Model indices of the base joints (x, y, yaw), if the model has all three.
-pub fn base_joints(model: &RobotModel) -> Option<[usize; 3]> {
-    let [x, y, yaw] = BASE_JOINTS.map(|n| model.joint_index(n));
-    Some([x?, y?, yaw?])
-}
-
 /// The base's joint values from odometry: `q` = (x, y, yaw) in the odometry frame, `qd` their
 /// world-frame rates.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -417,7 +410,7 @@ impl ScanConverter {
     /// a model without a base has none.
     pub fn new(model: &RobotModel) -> Self {
         let mut frames = Vec::new();
-        if let Some([_, _, yaw]) = base_joints(model) {
+        if let Some([_, _, yaw]) = model.planar_base() {
             let base_frame = model.joint_child_frame(yaw);
             let base_inv = model.frame_placement(base_frame).inverse();
             for (f, name) in model.frame_names().iter().enumerate() {

@@ -1,8 +1,9 @@
-//! The nodes' wiring (topics, timers, services, parameters), one module per node, so that a
-//! binary runs one node and `skin_stack` composes them all in one process (one r2r node each,
-//! one executor). Each `start` function creates the node's entities and spawns its tasks on a
-//! single-threaded `LocalPool`; the caller spins the node and runs the pool, then calls the
-//! handle's `stop` (final messages, summary) when SIGINT/SIGTERM arrives.
+//! The nodes' ROS wiring (topics, timers, services, parameters), one module per executable, each
+//! beside its work without ROS (docs/ros.md). The nodes that `skin_stack` composes in one process
+//! (one r2r node each, one executor) have a `start` function that creates the node's entities
+//! and spawns its tasks on a single-threaded `LocalPool`; the caller spins the node and runs the
+//! pool, then calls the handle's `stop` (final messages, summary) when SIGINT/SIGTERM arrives.
+//! The standalone ones ([`skin_aggregator`], [`skin_watchdog`]) have a `main`.
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -11,53 +12,13 @@ use anyhow::{Context as _, Result};
 use crate::paths;
 
 pub mod priority_supervisor;
+pub mod skin_aggregator;
+pub mod skin_watchdog;
 pub mod task_controller;
 
-/// Topic names of the graph (docs/ros.md), as they resolve in the root namespace (logs and the
-/// counters of `/controller/state` use these). The nodes create their publishers and
-/// subscriptions with the relative name ([`local`]), so that a node namespace
-/// (`__ns:=/tomm`, a launch file's `namespace`) and remapping apply; `/clock` and `/tf*` stay
-/// global, as in every ROS 2 node (rcl's time source subscribes `/clock`, tf2 `/tf`).
-pub mod topics {
-    /// Skin cells (skin_msgs/SkinCellArray).
-    pub const CELLS: &str = "/skin/cells";
-    /// The type of [`CELLS`], for raw subscriptions.
-    pub const CELLS_TYPE: &str = "skin_msgs/msg/SkinCellArray";
-    /// Patch wrenches (skin_msgs/PatchWrenchArray).
-    pub const PATCHES: &str = "/skin/patches";
-    /// Skin markers for RViz (visualization_msgs/MarkerArray).
-    pub const MARKERS: &str = "/skin/markers";
-    /// Joint states (sensor_msgs/JointState).
-    pub const JOINT_STATES: &str = "/joint_states";
-    /// Base odometry (nav_msgs/Odometry).
-    pub const ODOM: &str = "/base/odom";
-    /// Base LIDAR (sensor_msgs/LaserScan).
-    pub const SCAN: &str = "/scan";
-    /// End-effector goal (geometry_msgs/PoseStamped).
-    pub const GOAL: &str = "/goal";
-    /// Hand force reference in newtons (std_msgs/Float64).
-    pub const FORCE_REFERENCE: &str = "/hand_force_reference";
-    /// Base twist command (geometry_msgs/Twist).
-    pub const CMD_VEL: &str = "/base/cmd_vel";
-    /// Controller state (skin_msgs/ControllerState).
-    pub const CONTROLLER_STATE: &str = "/controller/state";
-    /// Active arrangement (skin_msgs/Arrangement, latched).
-    pub const ARRANGEMENT: &str = "/supervisor/arrangement";
-    /// Phase service (skin_msgs/srv/SetPhase).
-    pub const SET_PHASE: &str = "/supervisor/set_phase";
-    /// `skin_watchdog`'s trips (std_msgs/Header: it sent zero commands).
-    pub const WATCHDOG: &str = "/controller/watchdog";
-    /// Simulation clock (rosgraph_msgs/Clock): global.
-    pub const CLOCK: &str = "/clock";
-    /// Transforms (tf2_msgs/TFMessage): global.
-    pub const TF: &str = "/tf";
-    /// Fixed transforms (tf2_msgs/TFMessage, transient local): global.
-    pub const TF_STATIC: &str = "/tf_static";
-}
-
 /// The name a node creates its entity with: `topic` relative (without the leading `/`), so that
-/// the node's namespace and remapping rules apply. Global names ([`topics::CLOCK`],
-/// [`topics::TF`]) are passed as they are.
+/// the node's namespace and remapping rules apply. Global names ([`crate::topics::CLOCK`],
+/// [`crate::topics::TF`]) are passed as they are.
 pub fn local(topic: &str) -> &str {
     topic.strip_prefix('/').unwrap_or(topic)
 }
@@ -111,33 +72,6 @@ impl<const N: usize> OnceLog<N> {
     /// True the first time `kind` is seen.
     pub fn first(&mut self, kind: usize) -> bool {
         !std::mem::replace(&mut self.0[kind.min(N - 1)], true)
-    }
-}
-
-/// Durations of one stage over many runs (mean and max), for summaries.
-#[derive(Debug, Default, Clone, Copy)]
-pub struct Timing {
-    /// Number of runs.
-    pub count: u64,
-    /// Sum of durations.
-    pub total: Duration,
-    /// Longest.
-    pub max: Duration,
-}
-
-impl Timing {
-    /// Adds one run.
-    pub fn add(&mut self, d: Duration) {
-        self.count += 1;
-        self.total += d;
-        self.max = self.max.max(d);
-    }
-}
-
-impl std::fmt::Display for Timing {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let mean = self.total.checked_div(self.count.max(1) as u32).unwrap_or_default();
-        write!(f, "mean {mean:?}, max {:?}", self.max)
     }
 }
 

@@ -1,6 +1,6 @@
 //! `priority_supervisor`: `/controller/state` in, `/supervisor/arrangement` out (reliable,
 //! transient local: on every change and every `republish_period_s`), `/supervisor/set_phase`
-//! served. The work is in `crate::supervisor_node`.
+//! served. The work is in `crate::priority_supervisor`.
 use std::cell::RefCell;
 use std::rc::Rc;
 use std::time::Duration;
@@ -14,10 +14,10 @@ use r2r::skin_msgs::srv::SetPhase;
 use r2r::ParameterValue;
 use skin_core::controller::ControllerConfig;
 
-use super::topics::*;
 use super::{file_setting, resolve, ros_now};
+use crate::priority_supervisor::PrioritySupervisor;
 use crate::qos;
-use crate::supervisor_node::PrioritySupervisor;
+use crate::topics::*;
 
 /// Node name.
 pub const NODE: &str = "priority_supervisor";

@@ -18,12 +18,9 @@ use r2r::std_msgs::msg::{Float64, Float64MultiArray, Header, String as StringMsg
 use r2r::{ParameterValue, RosParams};
 use skin_core::controller::{ControllerConfig, ControllerSetup};
 use skin_core::model::RobotModel;
-use skin_core::param_file::declare::{Declared, ParamSpec};
-use skin_core::skin::params::SkinParams;
-use skin_core::tasks::params::TaskParams;
+use skin_core::param_file::declare::Declared;
 
-use super::topics::*;
-use super::{file_setting, local, resolve, resolved, ros_now, OnceLog, Timing};
+use super::{file_setting, local, resolve, resolved, ros_now, OnceLog};
 use crate::convert::robot::time_msg;
 use crate::diagnostics::{self, level, Diagnostics, LoopReport};
 use crate::heartbeat::{self, CommandType, Commander};
@@ -32,9 +29,11 @@ use crate::qos;
 use crate::robot_description::{self, UrdfSource};
 use crate::ros_params::StructParams;
 use crate::task_controller::{
-    Freshness, Idle, InputError, Outputs, TaskController, TaskControllerParams, Trigger, DESCRIPTIONS, START_ONLY,
+    Freshness, Idle, InputError, Outputs, TaskController, TaskControllerParams, Trigger, START_ONLY_SECTION,
 };
 use crate::tf::BASE_FRAME;
+use crate::timing::Timing;
+use crate::topics::*;
 use r2r::lifecycle_msgs::msg::{
     State as StateMsg, Transition, Transition as TransitionMsg, TransitionDescription, TransitionEvent,
 };
@@ -145,7 +144,7 @@ struct Shared {
     beat: Header,
     me: Commander,
     command: Command,
-    /// ROS time of the last commands sent \[s\].
+    /// ROS time of the last commands sent [s].
     last_sent_s: Option<f64>,
     /// Periods left of zero commands while taking over ([`TAKE_OVER_PERIODS`]).
     take_over: u32,
@@ -319,7 +318,7 @@ impl Shared {
         }
     }
 
-    /// The node's clock now \[s\].
+    /// The node's clock now [s].
     fn now(&self) -> f64 {
         self.clock.lock().unwrap().get_now().map(|d| d.as_secs_f64()).unwrap_or(0.0)
     }
@@ -471,6 +470,12 @@ impl TaskControllerHandle {
         }
     }
 
+    /// Whether the node was shut down through its lifecycle (`change_state` shutdown): the
+    /// service's reply is then still on its way to the caller.
+    pub fn finalized(&self) -> bool {
+        self.shared.borrow().lifecycle.state() == lifecycle::State::Finalized
+    }
+
     /// The controller's counts (cycles, safe-stop steps).
     pub fn counts(&self) -> (u64, u64) {
         self.shared.borrow().tc.counts()
@@ -546,14 +551,6 @@ fn serve_lifecycle(
     Ok(())
 }
 
-/// The declared skin model and task parameters under their `skin.` and `tasks.` prefixes.
-fn declared_specs() -> Vec<ParamSpec> {
-    let mut specs = Vec::new();
-    SkinParams::specs("skin.", &mut specs);
-    TaskParams::specs("tasks.", &mut specs);
-    specs
-}
-
 /// The system clock now \[s since the epoch\] (the stamp of `/diagnostics`, as diagnostic_updater's).
 fn system_now_s() -> f64 {
     std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64())
@@ -627,9 +624,9 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     let config = ControllerConfig::load_with_model(&setup_path, model).context("controller setup")?;
     diagnostics.set_hardware_id(config.model.name());
     let mut params =
-        StructParams::new(TaskControllerParams::defaults(&config), TaskControllerParams::validate, DESCRIPTIONS)?
-            .with_start_only(START_ONLY)
-            .with_specs(declared_specs())
+        StructParams::new(TaskControllerParams::defaults(&config), TaskControllerParams::validate)?
+            .with_specs(TaskControllerParams::all_specs())
+            .with_start_only_section(START_ONLY_SECTION)
             .with_read_only(
                 "setup_file",
                 ParameterValue::String(setup.clone()),

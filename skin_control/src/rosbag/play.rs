@@ -24,8 +24,8 @@ use r2r::rosgraph_msgs::msg::Clock;
 
 use super::{header_stamp, read_raw, step_groups, RawBag};
 use crate::nodes::topic_count;
-use crate::nodes::topics::CLOCK;
 use crate::shutdown;
+use crate::topics::CLOCK;
 
 /// Options of `skin_bag play`.
 #[derive(Debug, Clone, clap::Args)]

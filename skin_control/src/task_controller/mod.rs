@@ -18,7 +18,10 @@ use r2r::std_msgs::msg::Float64MultiArray;
 use serde::{Deserialize, Serialize};
 use skin_core::controller::HandForceMap;
 use skin_core::controller::{Controller, ControllerConfig, ControllerInput};
+use skin_core::declare_params;
+use skin_core::model::is_base_joint_name;
 use skin_core::model::{frame_pose, update_kinematics, ModelData};
+use skin_core::param_file::declare::{Declared, Range};
 use skin_core::skin::params::SkinParams;
 use skin_core::supervisor::Mode;
 use skin_core::tasks::params::TaskParams;
@@ -30,8 +33,8 @@ use crate::convert::control::{
 use crate::convert::robot::{goal_pose, time_s, JointIssue, JointStateIssue, ScanConverter, StateBuffer};
 use crate::convert::{update_cells, CellBuffer, CellMessage, Issue, IssueKind};
 use crate::input_health::{fresh, IssueTable, StampGate, StampIssue};
-use crate::nodes::topics::{ARRANGEMENT, CELLS, FORCE_REFERENCE, GOAL, JOINT_STATES, ODOM, SCAN};
 use crate::tf::{ODOM_FRAME, WORLD_FRAME};
+use crate::topics::{ARRANGEMENT, CELLS, FORCE_REFERENCE, GOAL, JOINT_STATES, ODOM, SCAN};
 
 /// What starts a control cycle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -58,16 +61,19 @@ pub enum SupervisorSource {
     Internal,
 }
 
-/// Which arms get commands: `namespaces[k]` + `/forward_velocity_controller/commands` carries the
-/// arm joints whose names start with `joint_prefixes[k]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ArmsParams {
-    /// Command namespaces, e.g. `[left_arm, right_arm]` (relative: under the node's namespace;
-    /// an absolute one, `/left_arm`, is not).
-    pub namespaces: Vec<String>,
-    /// Joint-name prefixes, e.g. `[left_, right_]` (an empty prefix takes every other joint).
-    pub joint_prefixes: Vec<String>,
+declare_params! {
+    /// Which arms get commands: `namespaces[k]` + `/forward_velocity_controller/commands` carries the
+    /// arm joints whose names start with `joint_prefixes[k]`.
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct ArmsParams {
+        /// Command namespaces, one per arm, e.g. `[left_arm, right_arm]` (relative: under the
+        /// node's namespace; an absolute one, `/left_arm`, is not).
+        pub namespaces: Vec<String> => { text: "names", live: false },
+        /// Joint-name prefix of each arm's joints, pairs with `arms.namespaces`, e.g.
+        /// `[left_, right_]` (an empty prefix takes every other joint).
+        pub joint_prefixes: Vec<String> => { text: "prefixes", live: false },
+    }
 }
 
 impl ArmsParams {
@@ -86,81 +92,56 @@ impl ArmsParams {
     }
 }
 
-/// The task controller's parameters, served as ROS parameters (`ros_params::StructParams`).
-/// `skin` and `tasks` are `skin_core`'s structs: their initial values come from the files the
-/// controller setup names, and the node's parameter overrides replace single keys.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TaskControllerParams {
-    /// Control rate \[Hz\] (the timer's, and `1 / dt` of every cycle).
-    pub control_rate_hz: f64,
-    /// `timer` or `inputs` ([`Trigger`]).
-    pub trigger: Trigger,
-    /// `topic` or `internal` ([`SupervisorSource`]).
-    pub supervisor: SupervisorSource,
-    /// Whether `/scan` is a required input (base avoidance, interactive-force-control paper eq. 15-17).
-    pub use_scan: bool,
-    /// Timer mode: joint states older than this (ROS time; per joint) make the commands ramp to
-    /// zero \[s\].
-    pub input_timeout_s: f64,
-    /// Timer mode: the same for odometry \[s\].
-    pub odom_timeout_s: f64,
-    /// Timer mode: the same for the skin cells \[s\].
-    pub cells_timeout_s: f64,
-    /// Timer mode: the same for the scan \[s\] (a LIDAR is slower than a joint driver).
-    pub scan_timeout_s: f64,
-    /// Timer mode: a message stamped further ahead of the node's clock than this is refused, and
-    /// an input whose age is below minus this is stale \[s\].
-    pub max_stamp_lead_s: f64,
-    /// Managed node: configure and activate at start (a simulation); false: hold still until
-    /// `change_state` activates it (a robot, as an operator does).
-    pub autostart: bool,
-    /// Timer mode: at start, listen this long for another controller's heartbeat on the same
-    /// command topics before commanding (one commander; DDS discovery takes up to seconds) \[s\].
-    pub commander_wait_s: f64,
-    /// The base command as `geometry_msgs/TwistStamped` (frame `base_link`, stamped with the
-    /// period's time), as ROS 2 Jazzy's ros2_control base controllers take it; false: `Twist`.
-    pub base_command_stamped: bool,
-    /// Command topics per arm.
-    pub arms: ArmsParams,
-    /// Skin model (`config/skin_model.yaml`).
-    pub skin: SkinParams,
-    /// Task gains (`config/tasks.yaml`).
-    pub tasks: TaskParams,
+declare_params! {
+    /// The task controller's parameters, served as ROS parameters (`ros_params::StructParams`).
+    /// `skin` and `tasks` are `skin_core`'s structs: their initial values come from the files the
+    /// controller setup names, and the node's parameter overrides replace single keys.
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct TaskControllerParams {
+        /// Control rate: the timer's, and `1 / dt` of every cycle.
+        pub control_rate_hz: f64 => { unit: "Hz", range: Range::positive(10_000.0), live: false },
+        /// `timer`: cycles on the ROS clock; `inputs`: one cycle per complete input set with a
+        /// common stamp (lockstep simulation).
+        pub trigger: Trigger => { choices: "timer | inputs", live: false },
+        /// `topic`: follow /supervisor/arrangement; `internal`: the controller's own supervisor
+        /// in the cycle.
+        pub supervisor: SupervisorSource => { choices: "topic | internal", live: false },
+        /// Whether `/scan` is a required input (base avoidance, interactive-force-control paper eq. 15-17).
+        pub use_scan: bool => { choices: "true | false", live: false },
+        /// Timer mode: a joint whose last value is older than this (ROS time; per joint) makes
+        /// the commands ramp to zero within the acceleration limits.
+        pub input_timeout_s: f64 => { unit: "s", range: TIMEOUT_RANGE, live: true },
+        /// Timer mode: the same for odometry.
+        pub odom_timeout_s: f64 => { unit: "s", range: TIMEOUT_RANGE, live: true },
+        /// Timer mode: the same for the skin cells.
+        pub cells_timeout_s: f64 => { unit: "s", range: TIMEOUT_RANGE, live: true },
+        /// Timer mode: the same for the scan (a LIDAR is slower than a joint driver).
+        pub scan_timeout_s: f64 => { unit: "s", range: TIMEOUT_RANGE, live: true },
+        /// Timer mode: a message stamped further ahead of the node's clock than this is refused,
+        /// and an input whose age is below minus this is stale.
+        pub max_stamp_lead_s: f64 => { unit: "s", range: Range::closed(0.0, 0.1), live: true },
+        /// Managed node: configure and activate at start (a simulation); false: hold still (zero
+        /// commands) until `<node>/change_state` activates it (a robot, as an operator does).
+        pub autostart: bool => { choices: "true | false", live: false },
+        /// Timer mode: at start, listen this long for another controller's heartbeat on the same
+        /// command topics before commanding (one commander; DDS discovery takes up to seconds).
+        pub commander_wait_s: f64 => { unit: "s", range: Range::closed(0.0, 10.0), live: false },
+        /// The base command as `geometry_msgs/TwistStamped` (frame `base_link`, stamped with the
+        /// period's time), as ROS 2 Jazzy's ros2_control base controllers take it; false: `Twist`.
+        pub base_command_stamped: bool => { choices: "true | false", live: false },
+        /// Command topics per arm.
+        pub arms: ArmsParams => nested,
+        /// Skin model (`config/skin_model.yaml`); read at start by this node.
+        pub skin: SkinParams => nested,
+        /// Task gains (`config/tasks.yaml`).
+        pub tasks: TaskParams => nested,
+    }
 }
 
-/// Keys that only the start reads (everything but the timeouts and `max_stamp_lead_s`): the
-/// controller is built from them once (`skin_core::controller::Controller` has no setter for them at run time).
-pub const START_ONLY: &[&str] = &[
-    "control_rate_hz",
-    "trigger",
-    "supervisor",
-    "use_scan",
-    "autostart",
-    "commander_wait_s",
-    "base_command_stamped",
-    "arms.",
-    "skin.",
-    "tasks.",
-];
-
-/// `ros2 param describe` texts.
-pub const DESCRIPTIONS: &[(&str, &str)] = &[
-    ("control_rate_hz", "Control rate [Hz]: timer period and dt of every cycle (start only)"),
-    ("trigger", "timer: cycles on the ROS clock; inputs: one cycle per complete input set with a common stamp (lockstep simulation) (start only)"),
-    ("supervisor", "topic: follow /supervisor/arrangement; internal: the controller's own supervisor in the cycle (start only)"),
-    ("use_scan", "Whether /scan is a required input (start only)"),
-    ("input_timeout_s", "Timer mode: a joint whose last value is older than this [s] makes the commands ramp to zero within the acceleration limits, in [0.001, 1] (settable)"),
-    ("odom_timeout_s", "Timer mode: odometry older than this [s] makes the commands ramp to zero, in [0.001, 1] (settable)"),
-    ("cells_timeout_s", "Timer mode: skin cells older than this [s] make the commands ramp to zero, in [0.001, 1] (settable)"),
-    ("scan_timeout_s", "Timer mode: a scan older than this [s] makes the commands ramp to zero, in [0.001, 1] (settable)"),
-    ("max_stamp_lead_s", "Timer mode: messages stamped more than this [s] ahead of the node's clock are refused, inputs whose age is below minus this are stale, in [0, 0.1] (settable)"),
-    ("autostart", "Configure and activate the managed node at start; false: hold still (zero commands) until <node>/change_state activates it (start only)"),
-    ("commander_wait_s", "Timer mode: at start, listen this long [s] for another task_controller's heartbeat on the same command topics before commanding; in [0, 10] (start only)"),
-    ("base_command_stamped", "Base command type: true: geometry_msgs/TwistStamped (frame base_link, the period's stamp; ros2_control's base controllers), false: geometry_msgs/Twist (start only)"),
-    ("arms.namespaces", "Command namespaces, one per arm: <ns>/forward_velocity_controller/commands (start only)"),
-    ("arms.joint_prefixes", "Joint-name prefix of each arm's joints, pairs with arms.namespaces (start only)"),
-];
+/// The section this node reads at start only although its declarations are `live` (they are,
+/// in the skin aggregator): the controller is built from it once.
+pub const START_ONLY_SECTION: &str = "skin.";
 
 impl TaskControllerParams {
     /// Defaults for `config`: timer at the arm resolver's rate, the supervisor node followed,
@@ -172,7 +153,7 @@ impl TaskControllerParams {
             control_rate_hz: config.resolver.arm.rate_hz,
             trigger: Trigger::Timer,
             supervisor: SupervisorSource::Topic,
-            use_scan: crate::convert::robot::base_joints(&config.model).is_some(),
+            use_scan: config.model.planar_base().is_some(),
             input_timeout_s: 0.1,
             odom_timeout_s: 0.1,
             cells_timeout_s: 0.1,
@@ -187,35 +168,30 @@ impl TaskControllerParams {
         }
     }
 
-    /// Checks every value; the error names the key.
+    /// Checks every value against its declared range, then the skin and task parameters'
+    /// own rules; the error names the key.
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.control_rate_hz.is_finite() && self.control_rate_hz > 0.0 && self.control_rate_hz <= 10_000.0) {
-            return Err(format!("`control_rate_hz` = {}: must be in (0, 10000]", self.control_rate_hz));
-        }
-        let ranges = [
-            ("input_timeout_s", self.input_timeout_s, TIMEOUT_RANGE),
-            ("odom_timeout_s", self.odom_timeout_s, TIMEOUT_RANGE),
-            ("cells_timeout_s", self.cells_timeout_s, TIMEOUT_RANGE),
-            ("scan_timeout_s", self.scan_timeout_s, TIMEOUT_RANGE),
-            ("max_stamp_lead_s", self.max_stamp_lead_s, LEAD_RANGE),
-            ("commander_wait_s", self.commander_wait_s, (0.0, 10.0)),
-        ];
-        for (key, v, (lo, hi)) in ranges {
-            if !(lo..=hi).contains(&v) {
-                return Err(format!("`{key}` = {v}: must be in [{lo}, {hi}] s"));
-            }
-        }
+        self.check("").map_err(|e| e.to_string())?;
         self.skin.validate().map_err(|e| format!("skin.{e}"))?;
         self.tasks.validate().map_err(|e| format!("tasks.{e}"))?;
         Ok(())
     }
 }
 
-/// Range of the input timeouts \[s\]: a longer one would let the controller command from a
-/// state a second old.
-pub const TIMEOUT_RANGE: (f64, f64) = (0.001, 1.0);
-/// Range of `max_stamp_lead_s` \[s\].
-pub const LEAD_RANGE: (f64, f64) = (0.0, 0.1);
+/// The node's own parameters (not `skin.*`, `tasks.*`) as a Markdown table, with the values
+/// `config` gives them by default (docs/ros.md).
+pub fn parameter_table(config: &ControllerConfig) -> String {
+    let own: Vec<_> = TaskControllerParams::all_specs()
+        .into_iter()
+        .filter(|s| !s.key.starts_with("skin.") && !s.key.starts_with("tasks."))
+        .collect();
+    let values = serde_json::to_value(TaskControllerParams::defaults(config)).expect("parameters serialize");
+    skin_core::param_file::declare::markdown_table(&own, &values)
+}
+
+/// Range of the input timeouts: a longer one would let the controller command from a state a
+/// second old.
+const TIMEOUT_RANGE: Range = Range::closed(0.001, 1.0);
 
 /// The messages of one cycle.
 pub struct Outputs<'a> {
@@ -647,7 +623,7 @@ impl TaskController {
     /// The required inputs that have not arrived yet (empty: complete).
     pub fn missing(&self) -> Vec<String> {
         let mut m: Vec<String> =
-            self.state.missing().filter(|n| !self.is_base_joint(n)).map(|n| format!("joint `{n}`")).collect();
+            self.state.missing().filter(|n| !is_base_joint_name(n)).map(|n| format!("joint `{n}`")).collect();
         if self.needs_odom && self.state.odom_time().is_none() {
             m.push("odometry".into());
         }
@@ -658,10 +634,6 @@ impl TaskController {
             m.push("scan".into());
         }
         m
-    }
-
-    fn is_base_joint(&self, name: &str) -> bool {
-        skin_core::resolver::BASE_JOINTS.contains(&name)
     }
 
     /// The required inputs' times \[s\] (joint states: oldest and newest joint) with their topic
@@ -695,7 +667,7 @@ impl TaskController {
                 detail: Some(format!("oldest joint `{name}`")),
             },
             None => {
-                let missing: Vec<&str> = self.state.missing().filter(|n| !self.is_base_joint(n)).collect();
+                let missing: Vec<&str> = self.state.missing().filter(|n| !is_base_joint_name(n)).collect();
                 InputAge {
                     topic: JOINT_STATES,
                     age_s: None,

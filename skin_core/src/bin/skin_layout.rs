@@ -8,7 +8,10 @@
 //!
 //! `--links` takes `link` (all its collision elements) or `link:i+j` (elements i, j in document
 //! order); `--faces link=+z,-z` restricts the box faces tiled on a link (default: all six);
-//! `--spheres` also tiles spheres; `--patch-frame link|primitive` places the patch frames.
+//! `--spheres` also tiles spheres, `--caps` the end caps of cylinders and capsules;
+//! `--patch-frame link|primitive` places the patch frames. It prints each patch's cells and the
+//! share of its link's surface within one pitch of a cell that faces it
+//! (`skin_core::skin::coverage`).
 //! `package://` mesh URIs are searched in `--package-path` directories, then `ROS_PACKAGE_PATH`,
 //! then `AMENT_PREFIX_PATH` (`skin_core::mesh::package`).
 
@@ -19,6 +22,7 @@ use clap::{Parser, ValueEnum};
 use nalgebra::Vector3;
 use skin_core::mesh::{load_uri, MeshMode, PackagePath};
 use skin_core::model::{RobotModel, Shape};
+use skin_core::skin::coverage::coverage;
 use skin_core::skin::generate::{generate_layout, GeneratorSpec, LinkSelection, PatchFrame};
 use skin_core::skin::tiling::Face;
 
@@ -47,6 +51,9 @@ struct Args {
     /// Tile sphere primitives too.
     #[arg(long)]
     spheres: bool,
+    /// Tile the end caps of cylinders (disks) and capsules (hemispheres) too.
+    #[arg(long)]
+    caps: bool,
     /// Patch frame placement.
     #[arg(long, value_enum, default_value_t = FrameArg::Primitive)]
     patch_frame: FrameArg,
@@ -120,6 +127,7 @@ fn main() -> Result<()> {
         pitch_m: args.pitch,
         faces,
         spheres: args.spheres,
+        caps: args.caps,
         patch_frame: match args.patch_frame {
             FrameArg::Link => PatchFrame::Link,
             FrameArg::Primitive => PatchFrame::Primitive,
@@ -130,7 +138,7 @@ fn main() -> Result<()> {
     };
     let layout = generate_layout(&model, &spec)?;
     // Sanity: the output must load and resolve like any other layout.
-    layout.resolve(&model).context("generated layout does not resolve")?;
+    let resolved = layout.resolve(&model).context("generated layout does not resolve")?;
 
     let command: Vec<String> =
         std::iter::once("skin_layout".to_string()).chain(std::env::args().skip(1).map(|a| quote(&a))).collect();
@@ -147,9 +155,14 @@ fn main() -> Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     std::fs::write(&out, text).with_context(|| format!("writing {}", out.display()))?;
+    let covered = coverage(&model, &resolved, args.pitch);
     for p in &layout.patches {
         let n = layout.cells.iter().filter(|c| c.patch == p.id).count();
-        eprintln!("patch {:>3} {:<28} {:>4} cells", p.id, p.link, n);
+        let share = match covered.iter().find(|c| c.link == p.link).and_then(|c| c.covered()) {
+            Some(share) => format!("{:>5.1} % of its surface covered", 100.0 * share),
+            None => "coverage not measured (meshes are not sampled)".into(),
+        };
+        eprintln!("patch {:>3} {:<28} {:>4} cells, {share}", p.id, p.link, n);
     }
     eprintln!("{}: {} patches, {} cells", out.display(), layout.patches.len(), layout.cells.len());
     Ok(())

@@ -3,8 +3,8 @@
 //! A spherical fingertip approaches (or presses on) the skin of a link at a chosen cell; the
 //! command derives every cell's proximity and force signals through the skin characteristics,
 //! then reports what the controllers will see: the patch wrenches of interactive-force-control paper eq. (6)-(8) and
-//! the joint torques of intentional-contact paper eq. (3)-(4) (proximity repulsion), eq. (6) (contact) and paper
-//! 003 eq. (13)-(14) (patch wrenches).
+//! the joint torques of intentional-contact paper eq. (3)-(4) (proximity repulsion), eq. (6) (contact) and
+//! interactive-force-control paper eq. (13)-(14) (patch wrenches).
 //!
 //! ```text
 //! skin_touch --urdf urdf/tomm.urdf --layout config/skin/tomm.yaml --params config/skin_model.yaml \

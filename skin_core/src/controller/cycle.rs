@@ -454,8 +454,11 @@ impl Controller {
                 self.clock.lap(Stage::Dynamics);
                 self.solver.solve_with_model(active, posture, true, &mut self.tau_k)
             }
-            HierarchyDynamics::Admittance => {
+            HierarchyDynamics::Admittance | HierarchyDynamics::AdmittanceInertia => {
                 self.resolver.virtual_dynamics(input.q, input.qd, input.dt_s, &mut self.mass, &mut self.bias);
+                if self.config.setup.hierarchy_dynamics == HierarchyDynamics::AdmittanceInertia {
+                    self.bias.fill(0.0); // the resolver's damping stays: bias g alone
+                }
                 for (j, _) in self.locked.iter().enumerate().filter(|(_, &l)| l) {
                     self.bias[j] = 0.0;
                     self.mass.row_mut(j).fill(0.0); // decoupled from the free joints (base x-y block)

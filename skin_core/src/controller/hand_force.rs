@@ -26,7 +26,7 @@ use nalgebra::Vector3;
 /// A cell counts as facing along the palm normal when `n_i · z_h` exceeds this (within ~25°).
 const FACING_COS: f64 = 0.9;
 
-/// The map `F [N] -> n f(F / n)` (the summed signal of an even press) for one controller's hand.
+/// The map `F \[N\] -> n f(F / n)` (the summed signal of an even press) for one controller's hand.
 #[derive(Debug, Clone, Copy)]
 pub struct HandForceMap {
     /// Hand cells facing along the hand's z axis.

@@ -78,6 +78,13 @@ pub enum HierarchyDynamics {
     /// `g + C_a q̇`): the executed acceleration is the hierarchy's, so strict priority holds in the
     /// motion the robot makes (interactive-force-control paper's acceleration levels: hand force, wrist).
     Admittance,
+    /// The resolver's virtual inertia (`M_a`, `M_b`) with the bias `g` alone: for the force levels
+    /// of the intentional-contact paper (eq. 2-9), which bring their own damping (eq. 8) and leave
+    /// the resolver's `C_a` to damp the rest. The resolver executes `M_a q̈ + C_a q̇ = τ* − g`; with
+    /// `C_a` proportional to `M_a` on the moving joints (as shipped: 10 / 0.5 on every arm joint)
+    /// a lower level then moves nothing a higher level controls, in the acceleration and in the
+    /// steady velocity (`docs/controller.md`: the projection leak).
+    AdmittanceInertia,
 }
 
 /// Everything a [`super::Controller`] is built from, loaded and validated.

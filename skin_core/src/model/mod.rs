@@ -170,6 +170,12 @@ pub(crate) struct Frame {
 /// A model has all three (a mobile robot) or none (a fixed arm).
 pub const BASE_JOINTS: [&str; 3] = ["base_x_joint", "base_y_joint", "base_yaw_joint"];
 
+/// Whether a joint called `name` is one of the holonomic base's joints, for a record that keeps
+/// only the names (use [`RobotModel::is_base_joint`] with a model).
+pub fn is_base_joint_name(name: &str) -> bool {
+    BASE_JOINTS.contains(&name)
+}
+
 /// Immutable robot model built from a URDF. Joint order ("model order") is depth-first from the
 /// root link, children in document order; it is the order of every q, q̇, τ vector.
 ///
@@ -271,6 +277,12 @@ impl RobotModel {
     pub fn planar_base(&self) -> Option<[usize; 3]> {
         let [x, y, yaw] = BASE_JOINTS.map(|n| self.joint_index(n));
         Some([x?, y?, yaw?])
+    }
+
+    /// Whether moving joint `j` is one of the holonomic base's joints ([`BASE_JOINTS`]); every
+    /// other moving joint belongs to an arm (or a torso, a head).
+    pub fn is_base_joint(&self, j: usize) -> bool {
+        is_base_joint_name(&self.joint_names[j])
     }
 
     /// Limits of the generalized coordinates in model order.

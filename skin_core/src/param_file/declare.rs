@@ -61,13 +61,15 @@ pub enum Values {
     Range(Range),
     /// One of these names (an enumeration; serde checks it).
     Choices(&'static str),
+    /// Free text of this form (names, topics; the loader checks what it must).
+    Text(&'static str),
 }
 
 impl fmt::Display for Values {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Values::Range(r) => r.fmt(f),
-            Values::Choices(c) => f.write_str(c),
+            Values::Choices(c) | Values::Text(c) => f.write_str(c),
         }
     }
 }
@@ -114,6 +116,17 @@ impl<T: Declared> Declared for Option<T> {
     }
 }
 
+/// A map of declared structs by name (per-joint overrides): keys `<prefix><name>.<field>`.
+impl<T: Declared> Declared for std::collections::BTreeMap<String, T> {
+    fn specs(prefix: &str, out: &mut Vec<ParamSpec>) {
+        T::specs(&format!("{prefix}<name>."), out)
+    }
+
+    fn check(&self, prefix: &str) -> Result<(), InvalidParam> {
+        self.iter().try_for_each(|(name, v)| v.check(&format!("{prefix}{name}.")))
+    }
+}
+
 /// The numbers in a parameter's value (one, or one per element).
 pub trait Numbers {
     /// Calls `f` with each number and its element index (`None` for a scalar).
@@ -123,6 +136,12 @@ pub trait Numbers {
 impl Numbers for f64 {
     fn each(&self, f: &mut dyn FnMut(Option<usize>, f64) -> Result<(), InvalidParam>) -> Result<(), InvalidParam> {
         f(None, *self)
+    }
+}
+
+impl Numbers for Option<f64> {
+    fn each(&self, f: &mut dyn FnMut(Option<usize>, f64) -> Result<(), InvalidParam>) -> Result<(), InvalidParam> {
+        self.map_or(Ok(()), |x| f(None, x))
     }
 }
 
@@ -169,7 +188,8 @@ pub fn description(lines: &[&str]) -> String {
 
 /// Writes a parameter struct and its [`Declared`] impl. Each field is followed by `=>` and
 /// `{ unit: "N/m", range: Range::positive(1e4), live: false }` (a number or numbers),
-/// `{ choices: "mean | max", live: true }` (an enumeration), or `nested` (a struct of its own,
+/// `{ choices: "mean | max", live: true }` (an enumeration; `"true | false"` for a flag),
+/// `{ text: "topic names", live: false }` (free text), or `nested` (a struct of its own,
 /// itself declared; `Option` of one too). Doc comments describe the parameter; `#[serde(...)]`
 /// attributes go after them.
 #[macro_export]
@@ -199,6 +219,7 @@ macro_rules! declare_params {
             }
 
             fn check(&self, prefix: &str) -> Result<(), $crate::param_file::InvalidParam> {
+                let _ = prefix; // a struct of text fields checks nothing
                 $( $crate::declare_params!(@check self, prefix, $field, $spec); )*
                 Ok(())
             }
@@ -209,25 +230,27 @@ macro_rules! declare_params {
     };
     (@spec $prefix:ident, $out:ident, $field:ident, $ty:ty, [$($doc:literal),*],
         { unit: $unit:literal, range: $range:expr, live: $live:expr }) => {
-        $out.push($crate::param_file::declare::ParamSpec {
-            key: format!("{}{}", $prefix, stringify!($field)),
-            unit: $unit,
-            values: $crate::param_file::declare::Values::Range($range),
-            description: $crate::param_file::declare::description(&[$($doc),*]),
-            live: $live,
-        })
+        $crate::declare_params!(@push $prefix, $out, $field, $unit, Range($range), [$($doc),*], $live)
     };
     (@spec $prefix:ident, $out:ident, $field:ident, $ty:ty, [$($doc:literal),*],
         { choices: $choices:literal, live: $live:expr }) => {
+        $crate::declare_params!(@push $prefix, $out, $field, "", Choices($choices), [$($doc),*], $live)
+    };
+    (@spec $prefix:ident, $out:ident, $field:ident, $ty:ty, [$($doc:literal),*],
+        { text: $text:literal, live: $live:expr }) => {
+        $crate::declare_params!(@push $prefix, $out, $field, "", Text($text), [$($doc),*], $live)
+    };
+    (@push $prefix:ident, $out:ident, $field:ident, $unit:literal, $kind:ident($values:expr), [$($doc:literal),*], $live:expr) => {
         $out.push($crate::param_file::declare::ParamSpec {
             key: format!("{}{}", $prefix, stringify!($field)),
-            unit: "",
-            values: $crate::param_file::declare::Values::Choices($choices),
+            unit: $unit,
+            values: $crate::param_file::declare::Values::$kind($values),
             description: $crate::param_file::declare::description(&[$($doc),*]),
             live: $live,
         })
     };
     (@check $self:ident, $prefix:ident, $field:ident, { choices: $choices:literal, live: $live:expr }) => {};
+    (@check $self:ident, $prefix:ident, $field:ident, { text: $text:literal, live: $live:expr }) => {};
     (@check $self:ident, $prefix:ident, $field:ident, nested) => {
         $crate::param_file::declare::Declared::check(&$self.$field, &format!("{}{}.", $prefix, stringify!($field)))?
     };

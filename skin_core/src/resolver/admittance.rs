@@ -15,7 +15,7 @@ pub struct Commands {
     /// Arm joint velocities \[rad/s or m/s\], in model order of the arm joints
     /// ([`Resolver::arm_joints`]).
     pub joint_velocities: Vec<f64>,
-    /// Base twist `(vx [m/s], vy [m/s], wz [rad/s])` in the BASE frame (a `geometry_msgs/Twist`'s
+    /// Base twist `(vx \[m/s\], vy \[m/s\], wz \[rad/s\])` in the BASE frame (a `geometry_msgs/Twist`'s
     /// linear.x, linear.y, angular.z); zero for a model without base.
     pub base_twist: [f64; 3],
 }

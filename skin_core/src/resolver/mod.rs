@@ -20,7 +20,6 @@ mod params;
 mod tests;
 
 /// The base joint names live with the model; re-exported where the resolver splits arm and base.
-pub use crate::model::BASE_JOINTS;
 pub use admittance::{Commands, Resolver};
 pub use error::ResolverError;
 pub use params::{ArmParams, BaseParams, JointOverride, ResolverParams};

@@ -387,7 +387,7 @@ fn resolver_velocity_scaling_keeps_the_arm_direction() {
     tau[arm[6]] = 2.0; // right arm: small, unaffected by the left arm's saturation
     let mut p = ResolverParams::default();
     p.arm.subtract_gravity = false;
-    p.arm.max_acceleration = 1e9;
+    p.arm.max_acceleration = 1e6;
     r.set_params(&m, p).unwrap();
     let c = r.update_arms(&tau, &zeros, &zeros, &zeros, ARM_DT).unwrap();
     let v = &c.joint_velocities;

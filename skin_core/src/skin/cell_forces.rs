@@ -72,7 +72,7 @@ pub fn cell_contact_forces<'a>(
 }
 
 /// The shared loop: every cell whose `magnitude(reading)` is positive gives a force of that
-/// magnitude [N] along its inward normal `-n_i`, at its world position.
+/// magnitude \[N\] along its inward normal `-n_i`, at its world position.
 fn inward_cell_forces<'a>(
     layout: &ResolvedLayout,
     readings: &[CellReading],

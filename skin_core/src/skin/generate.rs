@@ -8,9 +8,11 @@ use std::str::FromStr;
 use nalgebra::{Isometry3, Point3};
 use thiserror::Error;
 
+use super::coverage::{blind_points, surface};
 use super::layout::{CellSpec, PatchSpec, SkinLayout};
 use super::mesh_tiling::tile_mesh;
-use super::tiling::{tile_box, tile_cylinder, tile_sphere, Face, TiledCell};
+use super::surface::buried_in_others;
+use super::tiling::{tile_box, tile_caps, tile_cylinder, tile_sphere, Face, TiledCell};
 use crate::mesh::{self, MeshError, MeshMode, PackagePath};
 use crate::model::{RobotModel, Shape};
 
@@ -64,6 +66,8 @@ pub struct GeneratorSpec {
     pub faces: Vec<(String, Vec<Face>)>,
     /// Tile spheres too.
     pub spheres: bool,
+    /// Tile the end caps of cylinders (disks) and capsules (hemispheres) too.
+    pub caps: bool,
     /// Placement of the patch frames.
     pub patch_frame: PatchFrame,
     /// Mesh collision elements: tiled on their surface or on their fitted box.
@@ -128,7 +132,11 @@ fn tile_shape(shape: &Shape, faces: &[Face], spec: &GeneratorSpec, urdf: &Path) 
     Ok(match shape {
         Shape::Box { size } => tile_box(size, faces, pitch),
         Shape::Cylinder { radius, length } | Shape::Capsule { radius, length } => {
-            tile_cylinder(*radius, *length, pitch)
+            let mut cells = tile_cylinder(*radius, *length, pitch);
+            if spec.caps {
+                cells.extend(tile_caps(*radius, *length, pitch, matches!(shape, Shape::Capsule { .. })));
+            }
+            cells
         }
         Shape::Sphere { radius } if spec.spheres => tile_sphere(*radius, pitch),
         Shape::Sphere { .. } => Vec::new(),
@@ -150,6 +158,10 @@ fn tile_shape(shape: &Shape, faces: &[Face], spec: &GeneratorSpec, urdf: &Path) 
         }
     })
 }
+
+/// A cell this deep (in pitches) inside another primitive of its link is left out: a cell on
+/// the seam of two primitives stays.
+const BURIED_MARGIN: f64 = 0.05;
 
 /// Tiles the selected links of `model` (see [`super::tiling`] for the rules). Patch ids and
 /// cell ids count from 1 in output order; deterministic for a given model and spec.
@@ -196,26 +208,49 @@ pub fn generate_layout(model: &RobotModel, spec: &GeneratorSpec) -> Result<SkinL
         };
         let patch_id = layout.patches.len() as u32 + 1;
         let first_cell = layout.cells.len();
+        // Cells in the link frame: the tiling of each selected primitive without the cells
+        // buried in the link's other primitives (they would sense nothing), then a cell on
+        // every point the tiling leaves blind at the seams of primitives (where a neighbour's
+        // cells were buried), so that every point of the surface has one within a pitch.
+        let mut cells: Vec<TiledCell> = Vec::new();
         for &i in idx {
             let c = &collisions[i];
-            let patch_from_primitive = link_from_patch.inverse() * c.origin;
             let tiled = tile_shape(&c.shape, faces, spec, Path::new(&urdf)).map_err(|error| GenerateError::Mesh {
                 urdf: urdf.clone(),
                 link: link.clone(),
                 error,
             })?;
-            for cell in tiled {
-                let p = patch_from_primitive * Point3::from(cell.position);
-                let n = patch_from_primitive.rotation * cell.normal;
-                layout.cells.push(CellSpec {
-                    id: next_cell,
-                    patch: patch_id,
-                    position: [p.x, p.y, p.z],
-                    normal: [n.x, n.y, n.z],
-                    line: None,
-                });
-                next_cell += 1;
+            cells.extend(tiled.into_iter().filter_map(|cell| {
+                let p = c.origin * Point3::from(cell.position);
+                let hidden = buried_in_others(collisions, i, &p, BURIED_MARGIN * spec.pitch_m);
+                (!hidden).then(|| TiledCell { position: p.coords, normal: c.origin.rotation * cell.normal })
+            }));
+        }
+        if !cells.is_empty() {
+            // the surfaces the tiling covers (selected faces, caps, spheres), sampled finer
+            let fine = GeneratorSpec { pitch_m: spec.pitch_m / 3.0, ..spec.clone() };
+            let sample = |shape: &Shape| match shape {
+                Shape::Mesh { .. } => Vec::new(),
+                _ => tile_shape(shape, faces, &fine, Path::new(&urdf)).unwrap_or_default(),
+            };
+            for s in surface(collisions, idx, spec.pitch_m, sample) {
+                if blind_points(std::slice::from_ref(&s), &cells, spec.pitch_m).next().is_some() {
+                    cells.push(s);
+                }
             }
+        }
+        let patch_from_link = link_from_patch.inverse();
+        for cell in cells {
+            let p = patch_from_link * Point3::from(cell.position);
+            let n = patch_from_link.rotation * cell.normal;
+            layout.cells.push(CellSpec {
+                id: next_cell,
+                patch: patch_id,
+                position: [p.x, p.y, p.z],
+                normal: [n.x, n.y, n.z],
+                line: None,
+            });
+            next_cell += 1;
         }
         if layout.cells.len() == first_cell {
             if spec.skip_empty {

@@ -6,11 +6,13 @@
 //! - a cell's centre keeps half a pitch from every edge; an extent shorter than one pitch holds
 //!   one row/column at its middle if it is at least 0.75 pitch long, else none;
 //! - hexagonal packing: rows `pitch·√3/2` apart, odd rows shifted by half a pitch;
-//! - cylinders: lateral surface only (no end caps), rows along the axis, `n = floor(2πr/pitch)`
-//!   cells per ring; even rings start facing +y, odd rings are turned by half a step (so for odd
-//!   `n` they contain the cell facing -y, for even `n` both kinds of ring face ±y): a link
-//!   moving in a plane that contains the primitive's y axis has cells facing within that plane on
-//!   both sides; capsules: their cylindrical part;
+//! - cylinders: the lateral surface in rows along the axis, `n = floor(2πr/pitch)` cells per
+//!   ring; even rings start facing +y, odd rings are turned by half a step (so for odd `n` they
+//!   contain the cell facing -y, for even `n` both kinds of ring face ±y): a link moving in a
+//!   plane that contains the primitive's y axis has cells facing within that plane on both
+//!   sides; with caps ([`tile_caps`]), each end disk in concentric rings one pitch apart from
+//!   half a pitch inside the rim (a centre cell where the innermost ring leaves more than 0.9
+//!   pitch); capsules: their cylindrical part, with caps their two hemispheres;
 //! - boxes: the selected faces, each a hexagonal grid;
 //! - spheres: a Fibonacci lattice with as many cells as hexagons of the given pitch cover the
 //!   surface.
@@ -143,6 +145,45 @@ pub fn tile_cylinder(radius: f64, length: f64, pitch: f64) -> Vec<TiledCell> {
     out
 }
 
+/// Centres on a disk of `radius` (its centre at the origin): rings one pitch apart from half a
+/// pitch inside the rim, `floor(2πρ/pitch)` cells on a ring of radius `ρ` (at least one), and a
+/// centre cell where the innermost ring leaves more than 0.9 pitch (see the module rules).
+pub fn disk_centres(radius: f64, pitch: f64) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    let mut rho = radius - pitch / 2.0;
+    while rho >= pitch / 2.0 {
+        let n = cells_per_ring(rho, pitch).max(1);
+        out.extend((0..n).map(|k| {
+            let a = PI / 2.0 + 2.0 * PI * k as f64 / n as f64;
+            (rho * a.cos(), rho * a.sin())
+        }));
+        rho -= pitch;
+    }
+    let innermost = rho + pitch;
+    if (out.is_empty() && radius >= 0.375 * pitch) || (!out.is_empty() && innermost > 0.9 * pitch) {
+        out.push((0.0, 0.0));
+    }
+    out
+}
+
+/// The end caps of a cylinder (`length` long along z, centred): a disk at each end, or a
+/// capsule's hemispheres (its `length` between the centres of the caps).
+pub fn tile_caps(radius: f64, length: f64, pitch: f64, capsule: bool) -> Vec<TiledCell> {
+    let mut out = Vec::new();
+    for sign in [1.0, -1.0] {
+        let end = Vector3::z() * (sign * length / 2.0);
+        if capsule {
+            let half = tile_sphere(radius, pitch).into_iter().filter(|c| c.normal.z * sign > 0.0);
+            out.extend(half.map(|c| TiledCell { position: c.position + end, normal: c.normal }));
+        } else {
+            let normal = Vector3::z() * sign;
+            let disk = disk_centres(radius, pitch).into_iter();
+            out.extend(disk.map(|(x, y)| TiledCell { position: end + Vector3::new(x, y, 0.0), normal }));
+        }
+    }
+    out
+}
+
 /// Tiles the given faces of a box with full edge lengths `size`, in the order of `faces`.
 pub fn tile_box(size: &Vector3<f64>, faces: &[Face], pitch: f64) -> Vec<TiledCell> {
     let mut out = Vec::new();
@@ -229,6 +270,33 @@ mod tests {
         assert_eq!(cells_per_ring(0.045, 0.025), 11);
         let facing = |s: f64| odd.iter().filter(|c| c.normal.y * s > 1.0 - 1e-12).count();
         assert_eq!((facing(1.0), facing(-1.0)), (5, 4));
+    }
+
+    #[test]
+    fn caps_cover_the_end_disks_and_hemispheres() {
+        let pitch = 0.03;
+        // a disk narrower than 0.75 pitch holds no cell (as any extent, see the module rules)
+        assert!(tile_caps(0.01, 0.25, pitch, false).is_empty());
+        for radius in [0.012, 0.02, 0.045, 0.06, 0.2] {
+            let caps = tile_caps(radius, 0.25, pitch, false);
+            for c in &caps {
+                assert!((c.position.z.abs() - 0.125).abs() < 1e-12 && c.normal.z.abs() == 1.0);
+                assert!(c.position.xy().norm() <= radius - pitch / 2.0 + 1e-12 || c.position.xy().norm() == 0.0);
+            }
+            // every point of a disk is within one pitch of a cell of its cap
+            let top: Vec<_> = caps.iter().filter(|c| c.normal.z > 0.0).collect();
+            for i in 0..50 {
+                for j in 0..50 {
+                    let (x, y) = (radius * (i as f64 / 24.5 - 1.0), radius * (j as f64 / 24.5 - 1.0));
+                    if x.hypot(y) <= radius {
+                        let d = top.iter().map(|c| (c.position.x - x).hypot(c.position.y - y)).fold(f64::MAX, f64::min);
+                        assert!(d <= pitch, "r {radius}: ({x}, {y}) is {d} from a cell");
+                    }
+                }
+            }
+        }
+        let capsule = tile_caps(0.05, 0.2, pitch, true);
+        assert!(capsule.iter().all(|c| (c.position - Vector3::z() * 0.1 * c.normal.z.signum()).norm() - 0.05 < 1e-12));
     }
 
     #[test]

@@ -1,5 +1,5 @@
-//! The supervisor state machine: intentional-contact paper Table I switched on sensed conditions, or the paper
-//! 003 Table 1 phases switched on request. The exact rules are in `docs/supervisor.md`.
+//! The supervisor state machine: intentional-contact paper Table I switched on sensed conditions, or
+//! interactive-force-control paper Table 1 phases switched on request. The exact rules are in `docs/supervisor.md`.
 
 use super::blend::WeightShift;
 use super::log::TransitionLog;
@@ -72,6 +72,14 @@ pub struct Supervisor {
     hard_peak_n: f64,
     /// A push that reached ε_c was given up: (a) holds, no (a) → (b).
     blocked: Option<Blocked>,
+    /// Goal error when the current push began ((a) → (b)) or at its last hard contact: what the
+    /// next hard contact's goal error is compared with (NaN: none).
+    push_ref_error_m: f64,
+    /// Time of the last (b) → (c) (NaN: none yet).
+    push_limit_s: f64,
+    /// The hard contact (c) entered from (b) ends the push with another try (the push had got
+    /// the goal nearer, and the one before did not also reach ε_c within `retry_interval_s`).
+    retry: bool,
     over_limit: Dwell,
     released: Dwell,
     stuck: Dwell,
@@ -90,8 +98,8 @@ pub struct Supervisor {
 }
 
 impl Supervisor {
-    /// A supervisor at time `t0_s` in the initial mode of the policy: (a) avoidance for paper
-    /// 000, precontact for interactive-force-control paper. `t0_s` is the initial switch time.
+    /// A supervisor at time `t0_s` in the initial mode of the policy: (a) avoidance for
+    /// intentional-contact paper, precontact for interactive-force-control paper. `t0_s` is the initial switch time.
     pub fn new(params: &SupervisorParams, t0_s: f64) -> Result<Self, ParamError> {
         params.validate()?;
         let orders = params.task_indices()?;
@@ -124,6 +132,9 @@ impl Supervisor {
             resume: Mode::Avoidance,
             hard_peak_n: 0.0,
             blocked: None,
+            push_ref_error_m: f64::NAN,
+            push_limit_s: f64::NAN,
+            retry: false,
             over_limit: Dwell::IDLE,
             released: Dwell::IDLE,
             stuck: Dwell::IDLE,
@@ -282,6 +293,16 @@ impl Supervisor {
                 // A hard contact can happen in (a) or (b): checked first, it has priority.
                 if self.over_limit.step(t, over, over, dw.hard_contact_s) {
                     self.resume = mode;
+                    if mode == Mode::IntentionalContact {
+                        // Another try only if this push got the goal nearer (the obstacle gave
+                        // way) and the last hard contact of the push is long enough ago that the
+                        // (b) → (c) switch cannot repeat more than twice in `retry_interval_s`.
+                        let progress = self.push_ref_error_m - ge >= th.progress_min_m;
+                        let spaced = self.retry_spaced(t);
+                        self.retry = progress && spaced;
+                        self.push_ref_error_m = ge;
+                        self.push_limit_s = t;
+                    }
                     self.switch(t, Mode::HardContact, Cause::ContactOverLimit);
                     self.hard_peak_n = if fc.is_nan() { f64::INFINITY } else { fc };
                     return;
@@ -290,9 +311,12 @@ impl Supervisor {
                     if let Some(b) = self.blocked {
                         // Held after a failed push: only a changed situation lets (b) be tried
                         // again (progress toward the goal, or nothing in range any more).
+                        // (Not within `retry_interval_s` of the last (b) → (c): a push then is
+                        // a retry, and the arm backing out of range is no changed situation.)
                         let clear = fd <= th.obstacle_force_n;
                         let cleared = self.cleared.step(t, clear, clear, dw.clear_s);
-                        if cleared || ge < b.goal_error_m - th.progress_min_m {
+                        let spaced = self.retry_spaced(t);
+                        if spaced && (cleared || ge < b.goal_error_m - th.progress_min_m) {
                             self.blocked = None;
                         }
                         return;
@@ -307,6 +331,7 @@ impl Supervisor {
                         && fd > th.obstacle_force_n
                         && ge > th.goal_tolerance_m;
                     if self.stuck.step(t, set, keep, dw.stuck_s) {
+                        self.push_ref_error_m = ge;
                         self.switch(t, Mode::IntentionalContact, Cause::Stuck);
                     }
                 } else {
@@ -336,9 +361,13 @@ impl Supervisor {
             Mode::HardContact => {
                 self.hard_peak_n = if fc.is_nan() { f64::INFINITY } else { self.hard_peak_n.max(fc) };
                 if self.released.step(t, below, below, dw.contact_release_s) {
-                    if self.resume == Mode::IntentionalContact {
-                        // The push of (b) reached ε_c: pushing again would only hit ε_c again
-                        // (the (b) <-> (c) cycle of a fixed or too heavy obstacle).
+                    if self.resume == Mode::IntentionalContact && self.retry {
+                        // The obstacle gave way before the push reached ε_c: push on.
+                        self.switch(t, Mode::IntentionalContact, Cause::ContactReleased);
+                    } else if self.resume == Mode::IntentionalContact {
+                        // The push of (b) reached ε_c without getting the goal nearer (or again
+                        // too soon): pushing again would only hit ε_c again (the (b) <-> (c)
+                        // cycle of a fixed or too heavy obstacle).
                         self.blocked =
                             Some(Blocked { since_s: t, goal_error_m: ge, contact_force_n: self.hard_peak_n });
                         self.switch(t, Mode::Avoidance, Cause::PushBlocked);
@@ -387,6 +416,11 @@ impl Supervisor {
         } else {
             (*r + self.range.restore_rate_mps * dt).min(target)
         };
+    }
+
+    /// Whether the last (b) → (c) is at least `retry_interval_s` before `t` (or there was none).
+    fn retry_spaced(&self, t: f64) -> bool {
+        self.push_limit_s.is_nan() || t - self.push_limit_s >= self.dwell.retry_interval_s
     }
 
     fn switch(&mut self, t: f64, to: Mode, cause: Cause) {

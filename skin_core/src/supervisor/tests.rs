@@ -135,6 +135,38 @@ fn contact_over_limit_in_b_goes_to_c_and_the_push_is_given_up() {
     assert_eq!((b.since_s, b.goal_error_m, b.contact_force_n), (tr[0].t_s, 0.2, 6.0));
 }
 
+/// A push that got the goal nearer by `progress_min_m` since it began (or since its last hard
+/// contact) before reaching ε_c is tried again ((c) → (b)); a second hard contact within `retry_interval_s` gives it up,
+/// so (b) → (c) happens at most twice in that long (no chatter). A push that got nowhere is
+/// given up at once.
+#[test]
+fn a_push_that_made_progress_is_retried_once_per_interval() {
+    let p = params();
+    let min = p.thresholds.progress_min_m;
+    let (mut sup, mut t) = in_b(&p);
+    run(&mut sup, &mut t, 10, input(0.02, 0.0, 2.0, 0.2));
+    let tr = run(&mut sup, &mut t, 1, input(0.02, 0.0, 6.0, 0.2 - 2.0 * min));
+    assert_eq!((tr[0].to, tr[0].cause), (Mode::HardContact, Cause::ContactOverLimit));
+    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
+    assert_eq!(
+        (tr[0].from, tr[0].to, tr[0].cause),
+        (Mode::HardContact, Mode::IntentionalContact, Cause::ContactReleased)
+    );
+    assert_eq!(sup.blocked(), None);
+    // Progress again, but 0.8 s after the last hard contact: given up.
+    run(&mut sup, &mut t, 10, input(0.02, 0.0, 2.0, 0.2));
+    run(&mut sup, &mut t, 1, input(0.02, 0.0, 6.0, 0.2 - 4.0 * min));
+    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
+    assert_eq!(tr.last().map(|tr| tr.cause), Some(Cause::PushBlocked));
+
+    // No progress since the push began: blocked on the first hard contact.
+    let (mut sup, mut t) = in_b(&p);
+    run(&mut sup, &mut t, 10, input(0.02, 0.0, 2.0, 0.2));
+    run(&mut sup, &mut t, 1, input(0.0, 0.0, 6.0, 0.2 - 0.5 * min));
+    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
+    assert_eq!(tr.last().map(|tr| tr.cause), Some(Cause::PushBlocked));
+}
+
 /// Against a fixed obstacle the arm is stuck again right after backing off: while blocked the
 /// stuck test is off, so there is no second push (no (b) <-> (c) cycle); a new goal ends it.
 #[test]
@@ -162,6 +194,12 @@ fn blocked_ends_on_goal_progress_or_nothing_in_range() {
         run(&mut sup, &mut t, 10, input(0.0, 3.0, 8.0, 0.2));
         run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
         assert!(sup.blocked().is_some());
+        // Within `retry_interval_s` of the hard contact nothing ends the hold (the arm backing
+        // out of range is no changed situation).
+        let interval = (p.dwell.retry_interval_s / DT) as usize;
+        run(&mut sup, &mut t, interval - 220, input(0.0, 0.0, 0.0, 0.1));
+        assert!(sup.blocked().is_some(), "held until retry_interval_s after the hard contact");
+        run(&mut sup, &mut t, 20, input(0.0, 3.0, 0.0, 0.2));
         (sup, t)
     };
     let (mut sup, mut t) = blocked();
@@ -174,7 +212,7 @@ fn blocked_ends_on_goal_progress_or_nothing_in_range() {
     let steps = (p.dwell.clear_s / DT) as usize;
     run(&mut sup, &mut t, steps - 2, input(0.0, 0.0, 0.0, 0.3));
     assert!(sup.blocked().is_some(), "nothing in range for less than clear_s");
-    run(&mut sup, &mut t, 3, input(0.0, 0.0, 0.0, 0.3));
+    run(&mut sup, &mut t, 4, input(0.0, 0.0, 0.0, 0.3)); // 4: t is summed from DT, ~11 s here
     assert_eq!(sup.blocked(), None);
 
     let (mut sup, mut t) = blocked();

@@ -78,14 +78,14 @@ pub struct PhaseRefused {
 /// [`super::Supervisor::update`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SupervisorInput {
-    /// `‖ẋ‖` of the end effector [m/s].
+    /// `‖ẋ‖` of the end effector \[m/s\].
     pub ee_speed_mps: f64,
-    /// `‖F_d‖`, the largest skin repulsion force [N], computed with the NOMINAL sensing range
+    /// `‖F_d‖`, the largest skin repulsion force \[N\], computed with the NOMINAL sensing range
     /// (otherwise shrinking the range in (b) would itself read as "nothing in range").
     pub avoidance_force_n: f64,
-    /// `‖F_c‖`, the largest skin contact force [N].
+    /// `‖F_c‖`, the largest skin contact force \[N\].
     pub contact_force_n: f64,
-    /// Distance of the end effector to its goal [m].
+    /// Distance of the end effector to its goal \[m\].
     pub goal_error_m: f64,
 }
 
@@ -136,9 +136,9 @@ pub struct Blocked {
 pub struct Imposed {
     /// The mode (its task order comes from this supervisor's configuration).
     pub mode: Mode,
-    /// `t_t` of the switch at the deciding supervisor [s].
+    /// `t_t` of the switch at the deciding supervisor \[s\].
     pub switch_time_s: f64,
-    /// `d_range` [m].
+    /// `d_range` \[m\].
     pub sensing_range_m: f64,
     /// The fusion weight `w` the deciding supervisor shifts to.
     pub fusion_weight_target: f64,
@@ -147,7 +147,7 @@ pub struct Imposed {
 /// One arrangement switch.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Transition {
-    /// The update time of the switch, `t_t` of intentional-contact paper eq. (11) [s].
+    /// The update time of the switch, `t_t` of intentional-contact paper eq. (11) \[s\].
     pub t_s: f64,
     /// Mode before.
     pub from: Mode,
@@ -165,11 +165,11 @@ pub struct Arrangement {
     /// Indices into the configured task-name list, highest priority first (capacity reserved
     /// once, so switching does not allocate).
     pub(super) task_order: Vec<usize>,
-    /// `t_t` of intentional-contact paper eq. (11): time of the last switch [s].
+    /// `t_t` of intentional-contact paper eq. (11): time of the last switch \[s\].
     pub switch_time_s: f64,
-    /// δ_t of intentional-contact paper eq. (11) [1/s].
+    /// δ_t of intentional-contact paper eq. (11) \[1/s\].
     pub smoothing_gain_per_s: f64,
-    /// Current `d_range` of intentional-contact paper eq. (3) [m] (ramps during (b) and back in (a)).
+    /// Current `d_range` of intentional-contact paper eq. (3) \[m\] (ramps during (b) and back in (a)).
     pub sensing_range_m: f64,
     /// Current fusion weight `w` of interactive-force-control paper eq. (6) (follows the sigmoid after a phase switch).
     pub fusion_weight: f64,

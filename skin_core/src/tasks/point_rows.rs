@@ -66,7 +66,7 @@ impl PointRows {
     }
 }
 
-/// Pushes one force row `f` [N] along the inward normal `−n` of `cell` (world axes), at the cell:
+/// Pushes one force row `f` \[N\] along the inward normal `−n` of `cell` (world axes), at the cell:
 /// the row `−nᵀ J_v(p)` of intentional-contact paper eq. (4) / (6), with activation `a` in the null-space
 /// projector ([`TaskLevel::push_row_activated`]). `row` is scratch space (nv).
 pub(crate) fn push_inward_cell_row(

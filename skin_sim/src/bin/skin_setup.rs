@@ -15,7 +15,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use clap::Parser;
 use skin_core::mesh::MeshMode;
-use skin_core::resolver::BASE_JOINTS;
+use skin_core::model::BASE_JOINTS;
 use skin_sim::new_robot::base::with_planar_base;
 use skin_sim::new_robot::{pose, write_files, Choices};
 
@@ -102,7 +102,7 @@ fn run(args: Args) -> Result<()> {
         meshes: args.meshes,
         package_path: args.package_path.clone(),
         initial,
-        config_dir: skin_sim::scenario::config_dir(),
+        config_dir: skin_sim::scene::config_dir(),
         duration_s: args.duration,
     };
     let robot = choices.robot()?;

@@ -12,10 +12,10 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use clap::{Parser, Subcommand};
-use skin_sim::outputs::{FigurePng, KeyFrames, RunBag};
-use skin_sim::report::{write_all, MetricsJson, RunOutput, SummaryText};
-use skin_sim::runner::RunTarget;
-use skin_sim::scenario::SCENARIOS;
+use skin_sim::outputs::artifacts::{FigurePng, KeyFrames, RunBag};
+use skin_sim::outputs::report::{write_all, MetricsJson, RunOutput, SummaryText};
+use skin_sim::run::runner::RunTarget;
+use skin_sim::run::scenario::SCENARIOS;
 use skin_sim::scene::RunOverrides;
 use skin_sim::study::{self, StudyResults, StudyScenario};
 
@@ -94,13 +94,13 @@ struct CampaignArgs {
     /// Worker threads [default: the machine's cores].
     #[arg(long)]
     jobs: Option<usize>,
+    /// Run only the scenes of this family (planar_contact, tomm_reach, force_tracking,
+    /// tactile_guidance), with the ids they have in the whole campaign.
+    #[arg(long)]
+    family: Option<String>,
     /// Run only this scene (its full outputs go into <out>/<id>/).
     #[arg(long)]
     only: Option<usize>,
-    /// Run only the scenes of this family among the --scenes (planar_contact, tomm_reach,
-    /// force_tracking, tactile_guidance): the same scenes and ids as in the whole campaign.
-    #[arg(long)]
-    family: Option<String>,
     /// Output directory: results.json, summary.json.
     #[arg(long, default_value = "out/campaign")]
     out: PathBuf,
@@ -141,7 +141,7 @@ struct SweepArgs {
     quiet: bool,
 }
 
-/// The products of a run (`skin_sim::outputs::ALL`), the video when asked for.
+/// The products of a run (`skin_sim::outputs::artifacts::ALL`), the video when asked for.
 fn outputs(video: bool) -> Vec<Box<dyn RunOutput>> {
     vec![
         Box::new(MetricsJson),
@@ -292,9 +292,14 @@ fn campaign(args: CampaignArgs) -> anyhow::Result<bool> {
         return Ok(failures.is_empty());
     }
     let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    let only = args.family.as_deref().map(campaign::family).transpose().map_err(anyhow::Error::msg)?;
-    let total = campaign::scene_ids(args.scenes, only).len();
-    let (results, summary) = campaign::run(args.seed, args.scenes, only, jobs, |done, r| {
+    if let Some(f) = args.family.as_deref().filter(|f| !campaign::families::FAMILIES.iter().any(|x| x.name == *f)) {
+        anyhow::bail!("--family {f}: no such family (skin_sim/src/campaign/families.rs)");
+    }
+    let families = campaign::families::FAMILIES;
+    let total = (0..args.scenes)
+        .filter(|id| args.family.as_deref().is_none_or(|f| families[id % families.len()].name == f))
+        .count();
+    let (results, summary) = campaign::run(args.seed, args.scenes, jobs, args.family.as_deref(), |done, r| {
         if !args.quiet {
             let failures = campaign::failures(r);
             let status = if failures.is_empty() { "ok".to_string() } else { failures.join("; ") };

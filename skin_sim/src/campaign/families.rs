@@ -3,8 +3,8 @@
 
 use serde_json::{json, Value};
 
-use crate::noise::Noise;
 use crate::scene::spec::{ObjectSpec, SceneSpec, ShapeSpec};
+use crate::world::noise::Noise;
 
 /// Standard gravity \[m/s²\].
 const G: f64 = 9.81;

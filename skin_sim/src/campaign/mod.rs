@@ -15,14 +15,14 @@ use std::time::Instant;
 use serde::Serialize;
 use serde_json::Value;
 
-use crate::noise::Noise;
-use crate::outputs::FigurePng;
-use crate::report::{write_all, MetricsJson, SummaryText};
-use crate::runner::RunTarget;
-use crate::scenario;
+use crate::outputs::artifacts::FigurePng;
+use crate::outputs::report::{write_all, MetricsJson, SummaryText};
+use crate::run::runner::RunTarget;
+use crate::run::scenario;
 use crate::scene::spec::SceneSpec;
 use crate::scene::Scene;
 use crate::study::pool;
+use crate::world::noise::Noise;
 use families::{Family, FAMILIES};
 use verdict::{judge, overshoot_ok, Verdict};
 
@@ -164,31 +164,17 @@ pub fn summarize(seed: u64, results: &[SceneResult], wall_s: f64, jobs: usize) -
     }
 }
 
-/// The family named `name`, or an error listing the names.
-pub fn family(name: &str) -> Result<Family, String> {
-    FAMILIES.iter().find(|f| f.name == name).copied().ok_or_else(|| {
-        let names: Vec<&str> = FAMILIES.iter().map(|f| f.name).collect();
-        format!("no scene family `{name}` (families: {})", names.join(", "))
-    })
-}
-
-/// The ids among `0..n` of the scenes of family `only` (all without it): the same scenes and ids
-/// as in the whole campaign.
-pub fn scene_ids(n: usize, only: Option<Family>) -> Vec<usize> {
-    (0..n).filter(|id| only.is_none_or(|f| FAMILIES[id % FAMILIES.len()].name == f.name)).collect()
-}
-
-/// Runs the scenes [`scene_ids`]`(n, only)` of the campaign `seed` on `jobs` threads;
-/// `done(finished, result)` after each.
+/// Runs scenes `0..n` of the campaign `seed` on `jobs` threads, only those of the family named
+/// `family` if given (the same ids as in the whole campaign); `done(finished, result)` after each.
 pub fn run(
     seed: u64,
     n: usize,
-    only: Option<Family>,
     jobs: usize,
+    family: Option<&str>,
     mut done: impl FnMut(usize, &SceneResult),
 ) -> (Vec<SceneResult>, Summary) {
     let start = Instant::now();
-    let ids = scene_ids(n, only);
+    let ids: Vec<usize> = (0..n).filter(|id| family.is_none_or(|f| FAMILIES[id % FAMILIES.len()].name == f)).collect();
     let mut finished = 0;
     let results = pool::map(
         &ids,
@@ -245,7 +231,7 @@ pub fn robustness_md(results: &[SceneResult], s: &Summary) -> String {
          reaching over a table (obstacle shifts, masses, friction), force tracking (reference mean\n\
          2-8 N, amplitude, period 2-8 s, board tilt ±10°, base circle radius) and tactile guidance\n\
          (touched link, force, time).\n\n\
-         A safety violation (`skin_sim::safety`, the definition every scene check uses) is a\n\
+         A safety violation (`skin_sim::outputs::safety`, the definition every scene check uses) is a\n\
          non-finite command, a safe-stop cycle, an arm joint over its URDF velocity limit, a contact\n\
          above eps_c (in a force scene's contact phase: above the reference + 2 N) for more than\n\
          0.5 s in one event, or chatter (one arrangement switch more than twice within 10 s). A goal\n\
@@ -281,7 +267,7 @@ pub fn robustness_md(results: &[SceneResult], s: &Summary) -> String {
         classes.dedup();
         md += &format!("| {} | {} | {} | {} |\n", f.name, rows.len(), failing.len(), classes.join(", "));
     }
-    md += "\n## Failing scenes\n\nRerun one with `skin_sim campaign --seed <seed> --only <id>` (outputs in `out/campaign/<id>/`), one family with `--family <name>`.\n\n";
+    md += "\n## Failing scenes\n\nRerun one with `skin_sim campaign --seed <seed> --only <id>` (outputs in `out/campaign/<id>/`), one family with `--family <name>` (the same ids).\n\n";
     let mut any = false;
     for r in results {
         let f = failures(r);

@@ -3,9 +3,9 @@
 
 use serde::Serialize;
 
-use crate::outcome::FIRST_CONTACT_OVERSHOOT_N;
-use crate::report::RunReport;
-use crate::safety;
+use crate::outputs::outcome::FIRST_CONTACT_OVERSHOOT_N;
+use crate::outputs::report::RunReport;
+use crate::outputs::safety;
 
 /// The verdict on one scene.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -23,7 +23,7 @@ pub struct Verdict {
     pub first_contact_overshoot_n: Option<f64>,
 }
 
-/// The verdict on `report`: its safety by the one definition of [`crate::safety`], and its
+/// The verdict on `report`: its safety by the one definition of [`crate::outputs::safety`], and its
 /// success.
 pub fn judge(report: &RunReport) -> Verdict {
     let m = &report.metrics;

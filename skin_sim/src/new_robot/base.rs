@@ -1,11 +1,11 @@
 //! A planar mobile base for a URDF that has none as joints (a Tiago's base moves on wheels):
 //! `base_x_joint` and `base_y_joint` (prismatic along world x and y) and `base_yaw_joint`
 //! (continuous about z) put in front of the URDF's root link, the joints
-//! `skin_core::resolver::BASE_JOINTS` the controller and the simulator move a base with.
+//! `skin_core::model::BASE_JOINTS` the controller and the simulator move a base with.
 
 use std::path::Path;
 
-use skin_core::resolver::BASE_JOINTS;
+use skin_core::model::BASE_JOINTS;
 
 /// Mass \[kg\] and inertia \[kg m²\] of each of the two links between the joints (a moving body
 /// needs some; the base's admittance, not these, sets how it moves).

@@ -17,7 +17,7 @@ use std::path::PathBuf;
 
 use skin_core::mesh::{MeshMode, PackagePath};
 use skin_core::model::RobotModel;
-use skin_core::resolver::BASE_JOINTS;
+use skin_core::model::BASE_JOINTS;
 use skin_core::skin::generate::{generate_layout, GeneratorSpec, LinkSelection, PatchFrame};
 use skin_core::skin::layout::SkinLayout;
 use thiserror::Error;
@@ -35,7 +35,7 @@ pub struct Choices {
     pub end_effector: String,
     /// The joints that move (none: every moving joint between the root and the end effector).
     pub arm_joints: Vec<String>,
-    /// Keep the mobile base moving: the URDF's planar base joints (`skin_core::resolver::BASE_JOINTS`;
+    /// Keep the mobile base moving: the URDF's planar base joints (`skin_core::model::BASE_JOINTS`;
     /// `skin_setup` adds them with [`base::with_planar_base`] when the URDF has none) join the
     /// moving joints (never the arm's: the start configuration is searched with the base at 0).
     /// Without it a base is frozen.
@@ -221,6 +221,7 @@ impl Choices {
             pitch_m: self.pitch_m,
             faces: Vec::new(),
             spheres: true,
+            caps: true,
             patch_frame: PatchFrame::Link,
             meshes: self.meshes,
             package_path: PackagePath::from_env(&self.package_path),

@@ -8,7 +8,7 @@ use plotters::prelude::*;
 use skin_core::controller::Stage;
 
 use super::Series;
-use crate::plot::{font, legend, FONT, PALETTE};
+use crate::outputs::plot::{font, legend, FONT, PALETTE};
 
 fn err(e: impl std::fmt::Display) -> anyhow::Error {
     anyhow!("{e}")

@@ -10,15 +10,20 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use skin_core::mesh::{self, PackagePath, TriMesh};
+use skin_core::model::BASE_JOINTS;
 use skin_core::model::{RobotModel, Shape};
 use skin_core::param_file::yaml::{self, YamlError};
-use skin_core::resolver::BASE_JOINTS;
 use skin_core::skin::layout::{ResolvedLayout, SkinLayout};
 use skin_core::skin::params::SkinParams;
 use thiserror::Error;
 
 use check::{reject, Rejected};
 pub use spec::*;
+
+/// The repository's `config/` directory (scenes and controller setups).
+pub fn config_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../config")
+}
 
 /// A scene file that could not be loaded.
 #[derive(Debug, Error)]
@@ -106,7 +111,7 @@ impl Scene {
         let meshes = load_meshes(&model, &urdf, &PackagePath::from_env(&dirs)).map_err(invalid)?;
         let (moving, q0) = joint_setup(&spec.robot, &model).map_err(invalid)?;
         check_frames(&spec, &model).map_err(invalid)?;
-        let base_moves = BASE_JOINTS.iter().filter_map(|b| model.joint_index(b)).any(|j| moving[j]);
+        let base_moves = (0..model.nv()).filter(|&j| model.is_base_joint(j)).any(|j| moving[j]);
         if !spec.base_motions.is_empty() && !base_moves {
             return Err(invalid(reject(
                 "base_motions",
@@ -150,11 +155,7 @@ impl Scene {
 
     /// Model indices of the base joints (x, y, yaw) when the base moves in this scene.
     pub fn moving_base(&self) -> Option<[usize; 3]> {
-        let idx = BASE_JOINTS.map(|n| self.model.joint_index(n));
-        match idx {
-            [Some(x), Some(y), Some(w)] if self.moving[x] => Some([x, y, w]),
-            _ => None,
-        }
+        self.model.planar_base().filter(|[x, _, _]| self.moving[*x])
     }
 }
 
@@ -228,7 +229,7 @@ fn check_frames(spec: &SceneSpec, model: &RobotModel) -> Result<(), Rejected> {
     }
     if let Some(l) = &spec.lidar {
         frame("lidar.frame".into(), &l.frame)?;
-        if model.joint_index(BASE_JOINTS[2]).is_none() {
+        if model.planar_base().is_none() {
             return Err(reject("lidar", "the robot has no mobile base (no base frame for the scan)"));
         }
     }

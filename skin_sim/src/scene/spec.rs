@@ -55,13 +55,13 @@ pub struct SceneSpec {
     /// How the run is shown: camera and frame rate of the rendered frames and video.
     #[serde(default)]
     pub view: ViewSpec,
-    /// What a run must show (`skin_sim::outcome`; none: the defaults of its kind of scene).
+    /// What a run must show (`skin_sim::outputs::outcome`; none: the defaults of its kind of scene).
     #[serde(default)]
     pub expect: Option<ExpectSpec>,
 }
 
 /// The outcome a run of the scene must show (`expect:`), beside what every run is checked for
-/// (`skin_sim::safety`) and what every scene of its kind must show (a force scene: the first
+/// (`skin_sim::outputs::safety`) and what every scene of its kind must show (a force scene: the first
 /// touch, the rise, a finite from-touch RMS; a scene without goals and force references: no
 /// link presses on anything). Absent: a scene with goals expects the supervisor's goal
 /// tolerance and `ε_c`.
@@ -219,6 +219,22 @@ pub struct LidarSpec {
     /// Standard deviation of the Gaussian noise added to each range \[m\].
     #[serde(default)]
     pub noise_std_m: f64,
+}
+
+impl LidarSpec {
+    /// The fan's first ray angle and the angle between rays \[rad\], in the scanner frame: a full
+    /// circle has no end ray, a partial fan includes both of its edges.
+    pub fn fan(&self) -> (f64, f64) {
+        let fov = self.fov_deg.to_radians();
+        let step = if self.rays == 1 {
+            0.0
+        } else if self.fov_deg >= 360.0 {
+            fov / self.rays as f64
+        } else {
+            fov / (self.rays - 1) as f64
+        };
+        (if self.rays == 1 { 0.0 } else { -fov / 2.0 }, step)
+    }
 }
 
 fn default_lidar_frame() -> String {

@@ -9,7 +9,7 @@ use plotters::prelude::*;
 use super::analysis::{self, Candidate};
 use super::grid::Axis;
 use super::variant::PointResult;
-use crate::plot::{font, legend, FONT, PALETTE};
+use crate::outputs::plot::{font, legend, FONT, PALETTE};
 
 fn err(e: impl std::fmt::Display) -> anyhow::Error {
     anyhow!("{e}")

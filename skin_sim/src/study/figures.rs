@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::stability::{self, Instability};
-use crate::report::RunReport;
+use crate::outputs::report::RunReport;
 
 /// Every figure of a point that ran. Optional figures are None where they do not apply (no goal,
 /// no force reference, goal never reached).

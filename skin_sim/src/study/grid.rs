@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use skin_core::controller::ControllerConfig;
 use skin_core::hierarchy::InverseParams;
 
-use crate::runner::RunTarget;
+use crate::run::runner::RunTarget;
 use crate::scene::Scene;
 
 /// Control rates of the grid \[Hz\].

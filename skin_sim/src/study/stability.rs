@@ -16,7 +16,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::record::RunRecord;
+use crate::outputs::record::RunRecord;
 
 /// A state jump: one period's motion above this multiple of what the velocity limit allows.
 pub const JUMP_FACTOR: f64 = 3.0;

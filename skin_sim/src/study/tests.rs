@@ -1,6 +1,6 @@
 use super::grid::{self, Axis, Density, Point, StudyScenario};
 use super::*;
-use crate::runner::RunTarget;
+use crate::run::runner::RunTarget;
 
 /// A tiny study end to end: three 1 s points of `intentional_contact` on two threads, every
 /// figure present, the document is the same from the results file, it and its figures render.
@@ -66,7 +66,7 @@ fn tiny_study_runs_and_renders() {
 
 #[test]
 fn densities_keep_every_patch() {
-    let path = crate::scenario::config_dir().join("skin/tomm.yaml");
+    let path = crate::scene::config_dir().join("skin/tomm.yaml");
     let layout = skin_core::skin::layout::SkinLayout::load(&path).unwrap();
     let patches = |l: &skin_core::skin::layout::SkinLayout| {
         let mut p: Vec<u32> = l.cells.iter().map(|c| c.patch).collect();

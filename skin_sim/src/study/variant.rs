@@ -15,7 +15,7 @@ use skin_core::skin::layout::SkinLayout;
 use super::figures::{self, Figures};
 use super::grid::Point;
 use super::{cpu_time, density};
-use crate::runner::RunTarget;
+use crate::run::runner::RunTarget;
 use crate::scene::{RunOverrides, Scene, SceneSpec};
 
 /// What became of a point.

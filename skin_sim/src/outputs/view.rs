@@ -7,7 +7,6 @@
 use nalgebra::Isometry3;
 use skin_core::controller::ControllerConfig;
 use skin_core::model::{update_kinematics, ModelData, RobotModel};
-use skin_core::resolver::BASE_JOINTS;
 use skin_core::skin::aggregate::{aggregate_patches, FusionParams, PatchWrench};
 use skin_core::skin::layout::ResolvedLayout;
 use skin_core::skin::markers::SkinMarkers;
@@ -80,7 +79,7 @@ pub fn pose_array(p: &Isometry3<f64>) -> [f64; 7] {
 /// the yaw joint (`base_x_link`, `base_y_link`) are left out.
 pub fn tf_tree(model: &RobotModel) -> (Vec<usize>, Vec<Option<usize>>) {
     let virtual_links: Vec<usize> =
-        BASE_JOINTS[..2].iter().filter_map(|n| model.joint_index(n)).map(|j| model.joint_child_frame(j)).collect();
+        model.planar_base().into_iter().flat_map(|[x, y, _]| [x, y]).map(|j| model.joint_child_frame(j)).collect();
     let frames: Vec<usize> = (0..model.nframes()).filter(|f| !virtual_links.contains(f)).collect();
     let index = |f: usize| frames.iter().position(|&g| g == f);
     let parents = frames
@@ -193,7 +192,7 @@ mod tests {
 
     #[test]
     fn base_links_collapse_into_odom_to_base_link() {
-        let model = RobotModel::from_urdf_file(&crate::scenario::config_dir().join("../urdf/tomm.urdf")).unwrap();
+        let model = RobotModel::from_urdf_file(&crate::scene::config_dir().join("../urdf/tomm.urdf")).unwrap();
         let (frames, parents) = tf_tree(&model);
         let name = |k: usize| model.frame_names()[frames[k]].as_str();
         let parent = |link: &str| {
@@ -211,7 +210,7 @@ mod tests {
                 assert!(hops <= frames.len(), "{} is in a cycle", name(k));
             }
         }
-        let planar = RobotModel::from_urdf_file(&crate::scenario::config_dir().join("../urdf/planar7.urdf")).unwrap();
+        let planar = RobotModel::from_urdf_file(&crate::scene::config_dir().join("../urdf/planar7.urdf")).unwrap();
         let (frames, parents) = tf_tree(&planar);
         let name = |k: usize| planar.frame_names()[frames[k]].as_str();
         let of = |link: &str| parents[(0..frames.len()).find(|&k| name(k) == link).unwrap()].map_or(ODOM_FRAME, name);

@@ -8,7 +8,7 @@
 use serde::Serialize;
 use skin_core::supervisor::Mode;
 
-use crate::record::{CycleRecord, RunRecord};
+use crate::outputs::record::{CycleRecord, RunRecord};
 
 /// Longest a contact force may stay above its limit in one event \[s\] (issue 17: the robot must
 /// relieve a hard contact within 0.5 s, whatever caused it).

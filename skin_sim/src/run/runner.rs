@@ -8,17 +8,17 @@ use std::time::Instant;
 use skin_core::controller::Controller;
 use skin_core::supervisor::{Mode, SupervisorInput};
 
-use crate::closed_loop::{ClosedLoop, LoopError};
-use crate::interaction::Interactions;
-use crate::metrics::{self, Limits};
-use crate::outcome;
-use crate::probe::ContactProbe;
-use crate::record::{CycleRecord, RunRecord, Switch};
-use crate::report::RunReport;
-use crate::safety::SafetyLimits;
-use crate::scenario::{self, Scenario};
+use crate::outputs::metrics::{self, Limits};
+use crate::outputs::outcome;
+use crate::outputs::record::{CycleRecord, RunRecord, Switch};
+use crate::outputs::report::RunReport;
+use crate::outputs::safety::SafetyLimits;
+use crate::outputs::view::ViewRecorder;
+use crate::run::closed_loop::{ClosedLoop, LoopError};
+use crate::run::interaction::Interactions;
+use crate::run::scenario::{self, Scenario};
 use crate::scene::{RunOverrides, Scene};
-use crate::view::ViewRecorder;
+use crate::world::probe::ContactProbe;
 use skin_core::controller::HandForceMap;
 
 /// What to run: a scene and the controller setup for it (what it is judged on is in the scene

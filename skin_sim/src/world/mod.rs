@@ -1,26 +1,36 @@
-//! The simulated world of a scene: MuJoCo model and data generated from it, the robot's velocity
-//! interface (arm joint velocities, a base twist in the base frame), its state in skin_core's
-//! joint order, scripted pushes and persons, and the skin and LIDAR sampled at their rates.
+//! The simulated world of a scene: MuJoCo model and data generated from it ([`mjcf`]), the
+//! robot's velocity interface (arm joint velocities, a base twist in the base frame), its state in
+//! skin_core's joint order, scripted pushes and persons, and the simulated sensors sampled at
+//! their rates: the [`skin_sensor`] (proximity rays, contact forces per cell), the [`lidar`]
+//! and the physical contact forces of the [`probe`], with seeded [`noise`].
+
+mod cell_face;
+mod frames;
+pub mod lidar;
+pub mod mjcf;
+pub mod noise;
+pub mod probe;
+mod proximity_rays;
+pub mod skin_sensor;
 
 use std::path::Path;
 use std::sync::Once;
 
 use mujoco_rs::prelude::*;
 use nalgebra::{Isometry3, Point3, Vector3};
-use skin_core::resolver::BASE_JOINTS;
 use skin_core::skin::markers::SkinMarker;
 use skin_core::skin::signals::CellReading;
 use thiserror::Error;
 
-use crate::frames::{body_pose, FrameRef};
-use crate::lidar::Lidar;
-use crate::mjcf::{scene_xml, MjcfError};
 use crate::scene::spec::push_scale;
 use crate::scene::{Scene, SceneError};
-use crate::skin_sensor::{SkinSensor, Touch};
+use crate::world::frames::{body_pose, FrameRef};
+use crate::world::lidar::Lidar;
+use crate::world::mjcf::{scene_xml, MjcfError};
+use crate::world::skin_sensor::{SkinSensor, Touch};
 
 /// The simulation's state at one moment of a run, for the recording's `/tf` and `/skin/markers`
-/// and for rendering (`keyframes.json`): one frame of the run's [`crate::view::View`].
+/// and for rendering (`keyframes.json`): one frame of the run's [`crate::outputs::view::View`].
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct KeyFrame {
     /// Simulation time \[s\].
@@ -34,7 +44,7 @@ pub struct KeyFrame {
     pub qpos: Vec<f64>,
     /// MuJoCo `mocap_pos` (persons).
     pub mocap_pos: Vec<[f64; 3]>,
-    /// World (odom) pose of every link of [`crate::view::View::links`], `[x, y, z, qx, qy, qz, qw]`.
+    /// World (odom) pose of every link of [`crate::outputs::view::View::links`], `[x, y, z, qx, qy, qz, qw]`.
     pub poses: Vec<[f64; 7]>,
     /// The `/skin/markers` updates since the previous frame (applied in order, as RViz does).
     pub markers: Vec<SkinMarker>,
@@ -173,7 +183,7 @@ impl World {
                 })
             })
             .collect();
-        let arm = (0..model.nv()).filter(|&j| !BASE_JOINTS.contains(&model.joint_names()[j].as_str())).collect();
+        let arm = (0..model.nv()).filter(|&j| !model.is_base_joint(j)).collect();
         let pushes = scene
             .spec
             .pushes
@@ -299,7 +309,7 @@ impl World {
         Ok(())
     }
 
-    /// Commands the base twist `(vx [m/s], vy [m/s], wz [rad/s])` in the BASE frame; ignored when
+    /// Commands the base twist `(vx \[m/s\], vy \[m/s\], wz \[rad/s\])` in the BASE frame; ignored when
     /// the scene freezes the base. Held until the next call; turned into world-frame joint
     /// velocities at every step from the current yaw.
     pub fn set_base_twist(&mut self, twist: [f64; 3]) {

@@ -1,5 +1,5 @@
 //! What a run leaves in its output directory. Every product is a [`RunOutput`]: `metrics.json`
-//! and `summary.txt` here; the figure (`skin_sim::plot`) and the bag (`skin_sim::bag`) plug in
+//! and `summary.txt` here; the figure (`skin_sim::outputs::plot`) and the bag (`skin_sim::bag`) plug in
 //! as further implementations, all fed the same [`RunReport`].
 
 use std::fmt::Write;
@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use crate::metrics::Metrics;
-use crate::outcome::Check;
-use crate::record::RunRecord;
+use crate::outputs::metrics::Metrics;
+use crate::outputs::outcome::Check;
+use crate::outputs::record::RunRecord;
 
 /// A finished run: its record, its metrics and its outcome checks.
 #[derive(Debug, Clone)]

@@ -2,7 +2,7 @@
 //! shipped DejaVu Sans font (no system fontconfig), in the style of the papers' signal figures.
 //!
 //! ```no_run
-//! use skin_sim::plot::{Figure, Panel, Tint};
+//! use skin_sim::outputs::plot::{Figure, Panel, Tint};
 //! let t = [0.0, 0.1, 0.2];
 //! Figure::new("run")
 //!     .panel(Panel::steps("(a) Arrangement", "", &["(a)", "(b)", "(c)"], &t, &[0, 1, 1]))

@@ -1,9 +1,11 @@
 //! The scenarios: a scene file and the controller setup that runs it. The outcome the papers
-//! report for it is declared in the scene file (`expect:`, checked by [`crate::outcome`]), so a
+//! report for it is declared in the scene file (`expect:`, checked by [`crate::outputs::outcome`]), so a
 //! copy of the file under another name is checked the same way. `docs/scenarios.md` has the
 //! measured numbers.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
+
+use crate::scene::config_dir;
 
 /// A named scenario.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -58,11 +60,6 @@ pub const SCENARIOS: [Scenario; 7] = [
 /// The scenario called `name`.
 pub fn find(name: &str) -> Option<&'static Scenario> {
     SCENARIOS.iter().find(|s| s.name == name)
-}
-
-/// The repository's `config/` directory (scenes and controller setups).
-pub fn config_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../config")
 }
 
 impl Scenario {

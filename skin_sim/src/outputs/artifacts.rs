@@ -4,19 +4,19 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use skin_core::resolver::BASE_JOINTS;
+use skin_core::model::BASE_JOINTS;
 use skin_core::supervisor::Mode;
 
 use nalgebra::{Isometry3, Quaternion as NaQuaternion, Translation3, UnitQuaternion};
 use skin_core::skin::markers::{MarkerAction, MarkerShape, Rgba, SkinMarker};
 
-use crate::plot::{
+use crate::outputs::plot::{
     guidance_figure, intervals_where, paper000_figure, paper003_figure, GuidanceSignals, Paper000Signals,
     Paper003Signals,
 };
-use crate::record::{CycleRecord, RunRecord};
-use crate::report::{MetricsJson, RunOutput, RunReport, SummaryText};
-use crate::view::{View, ODOM_FRAME};
+use crate::outputs::record::{CycleRecord, RunRecord};
+use crate::outputs::report::{MetricsJson, RunOutput, RunReport, SummaryText};
+use crate::outputs::view::{View, ODOM_FRAME};
 use crate::world::KeyFrame;
 use skin_bag::msgs::{
     Arrangement, Clock, ColorRgba, ControllerState, Float64MultiArray, Header, JointState, Marker, MarkerArray, Point,
@@ -47,7 +47,7 @@ impl RunOutput for KeyFrames {
         let frames = serde_json::to_string(&r.view).context("the view as JSON")?;
         let json = dir.join("keyframes.json");
         std::fs::write(&json, frames).with_context(|| format!("writing {}", json.display()))?;
-        let script = crate::scenario::config_dir().join("../scripts/render_keyframes.py");
+        let script = crate::scene::config_dir().join("../scripts/render_keyframes.py");
         let mut command = std::process::Command::new("python3");
         command.arg(&script).arg(dir).arg("--title").arg(&r.name);
         if self.video {
@@ -166,7 +166,7 @@ impl RunOutput for FigurePng {
 /// `/arm/...` otherwise), `/base/cmd_vel` (a model with a base), `/controller/state`;
 /// `/supervisor/arrangement` at the start and at every switch; `/robot_description` once
 /// (transient local, as `robot_state_publisher` offers it); per frame of the run's view `/tf`
-/// (`odom -> base_link` and every link from the joint states, [`crate::view::tf_tree`]) and
+/// (`odom -> base_link` and every link from the joint states, [`crate::outputs::view::tf_tree`]) and
 /// `/skin/markers` (the aggregator's marker updates). So Foxglove or RViz replaying the file shows
 /// the robot, the skin and the contacts. The skin cells, odometry and scan are not in the run
 /// record, so not in the bag.

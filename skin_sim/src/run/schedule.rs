@@ -8,7 +8,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use skin_core::controller::{Controller, Fault};
 use skin_core::supervisor::{Phase, Policy};
 
-use crate::base_motion::BaseMotions;
+use crate::run::base_motion::BaseMotions;
 use crate::scene::{ForceReferenceSpec, GoalSpec, Scene};
 use skin_core::controller::HandForceMap;
 

@@ -1,8 +1,8 @@
 //! The outcome checks of a run (what the scenario must show): each a named pass/fail with the measured
 //! number and its limit.
 
-use crate::metrics::{Metrics, FORCE_RISE_LIMIT_S, RECOVERY_LIMIT_S};
-use crate::safety;
+use crate::outputs::metrics::{Metrics, FORCE_RISE_LIMIT_S, RECOVERY_LIMIT_S};
+use crate::outputs::safety;
 use crate::scene::spec::ExpectSpec;
 
 /// One check.
@@ -127,8 +127,8 @@ pub fn checks(m: &Metrics, expect: Option<&ExpectSpec>) -> Vec<Check> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::metrics::GoalMetrics;
-    use crate::safety::SafetyMetrics;
+    use crate::outputs::metrics::GoalMetrics;
+    use crate::outputs::safety::SafetyMetrics;
 
     fn goal_run(outcome: &'static str, error_m: f64, peak_n: f64) -> Metrics {
         Metrics {

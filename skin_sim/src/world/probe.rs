@@ -6,8 +6,8 @@
 use mujoco_rs::mujoco_c;
 use nalgebra::Vector3;
 
-use crate::frames::FrameRef;
-use crate::mjcf::{ROBOT_GROUP, SENSED_GROUPS};
+use crate::world::frames::FrameRef;
+use crate::world::mjcf::{ROBOT_GROUP, SENSED_GROUPS};
 use crate::world::World;
 
 /// Contact forces on the robot and the hand's place at the world's current state.

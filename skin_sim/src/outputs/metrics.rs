@@ -3,11 +3,11 @@
 //! with force references (interactive-force-control paper Table 3).
 
 use serde::Serialize;
-use skin_core::resolver::BASE_JOINTS;
+use skin_core::model::is_base_joint_name;
 use skin_core::supervisor::Mode;
 
-use crate::record::{CycleRecord, RunRecord};
-use crate::safety::{self, SafetyLimits, SafetyMetrics};
+use crate::outputs::record::{CycleRecord, RunRecord};
+use crate::outputs::safety::{self, SafetyLimits, SafetyMetrics};
 use crate::scene::Scene;
 
 /// An interaction's effect on the force outlasts it: cycles this long after one count as "with
@@ -53,7 +53,7 @@ pub struct Metrics {
     pub arrangement_switches: Vec<SwitchEntry>,
     /// Cycles that were safe-stop steps (a fault of the controller or of its inputs).
     pub faulted_cycles: usize,
-    /// Every scene: the figures of the shared safety definition (`crate::safety`).
+    /// Every scene: the figures of the shared safety definition (`crate::outputs::safety`).
     #[serde(flatten)]
     pub safety: SafetyMetrics,
     /// Intentional-contact paper figures (scenes with goals).
@@ -182,7 +182,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 pub fn compute(record: &RunRecord, scene: &Scene, limits: &Limits) -> Metrics {
     let cycles = &record.cycles;
     let arm: Vec<usize> =
-        (0..record.joint_names.len()).filter(|&j| !BASE_JOINTS.contains(&record.joint_names[j].as_str())).collect();
+        (0..record.joint_names.len()).filter(|&j| !is_base_joint_name(&record.joint_names[j])).collect();
     let max_joint_speed = cycles.iter().flat_map(|c| arm.iter().map(move |&j| c.qd[j].abs())).fold(0.0, f64::max);
     let sim = record.sim_duration_s();
     Metrics {

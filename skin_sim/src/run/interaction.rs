@@ -3,7 +3,6 @@
 //! footprint (red areas), or a commanded base motion (interactive-force-control paper Exp. 1's circle and swings).
 //! Interactive-force-control paper Table 3 splits the force-tracking error by these periods.
 
-use skin_core::resolver::BASE_JOINTS;
 use skin_core::tasks::params::BaseAvoidanceParams;
 
 use crate::scene::{PersonSpec, PushSpec, Scene};
@@ -23,16 +22,12 @@ impl Interactions {
     /// The interactions of `scene`, with the base footprint and range of base avoidance.
     pub fn new(scene: &Scene, footprint: BaseAvoidanceParams) -> Self {
         let on_robot = |p: &&PushSpec| p.link.is_some();
-        let base = BASE_JOINTS.map(|n| scene.model.joint_index(n));
         Interactions {
             windows: (scene.spec.pushes.iter().filter(on_robot).map(|p| (p.start_s, p.end_s)))
                 .chain(scene.spec.base_motions.iter().map(|m| (m.start_s, m.end_s)))
                 .collect(),
             persons: scene.spec.persons.clone(),
-            base: match base {
-                [Some(x), Some(y), Some(w)] => Some([x, y, w]),
-                _ => None,
-            },
+            base: scene.model.planar_base(),
             footprint,
         }
     }

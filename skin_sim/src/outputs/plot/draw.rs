@@ -12,7 +12,7 @@ use super::{Content, Figure, Interval, Panel, Tint, TITLE_HEIGHT};
 
 /// Family name the shipped font is registered under (ab_glyph looks fonts up by name).
 pub(crate) const FONT: &str = "sans-serif";
-static FONT_TTF: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+static FONT_TTF: &[u8] = include_bytes!("../../../assets/DejaVuSans.ttf");
 
 /// Line colours, in order of the lines of a panel (matplotlib's tab10 start).
 pub(crate) const PALETTE: [RGBColor; 6] = [

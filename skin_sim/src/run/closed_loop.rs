@@ -16,12 +16,12 @@ use nalgebra::Vector2;
 use skin_core::controller::{Controller, ControllerConfig, ControllerInput, SetupError};
 use thiserror::Error;
 
-use crate::interaction::Interactions;
-use crate::probe::ContactProbe;
-use crate::record::{CycleRecord, RunRecord, Switch};
+use crate::outputs::record::{CycleRecord, RunRecord, Switch};
+use crate::outputs::view::ViewRecorder;
+use crate::run::interaction::Interactions;
+use crate::run::schedule::{Schedule, ScheduleError, ScheduledInputs};
 use crate::scene::Scene;
-use crate::schedule::{Schedule, ScheduleError, ScheduledInputs};
-use crate::view::ViewRecorder;
+use crate::world::probe::ContactProbe;
 use crate::world::{World, WorldError};
 
 /// Why a closed loop could not be built or run.

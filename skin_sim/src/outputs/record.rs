@@ -1,11 +1,11 @@
 //! The run record of a closed-loop simulation: one [`CycleRecord`] per control cycle and the
-//! arrangement switches, everything the metrics, the summary, the plots (`skin_sim::plot`) and the
+//! arrangement switches, everything the metrics, the summary, the plots (`skin_sim::outputs::plot`) and the
 //! bag writer (the `skin_bag` crate) read. Plain data; nothing in it is computed twice.
 
 use crate::world::KeyFrame;
 use skin_core::supervisor::{Mode, SupervisorInput};
 
-use crate::view::View;
+use crate::outputs::view::View;
 
 /// One control cycle: the measurements the controller got, what it decided and what the
 /// simulation measured at the same instant.
@@ -107,7 +107,7 @@ pub struct RunRecord {
     /// The MJCF the run simulated (primitive geoms only: self-contained).
     pub mjcf: String,
     /// What a viewer sees: frames at the view rate and the key frames (the start, the first
-    /// switches, the end; at most [`crate::view::MAX_KEY_FRAMES`]).
+    /// switches, the end; at most [`crate::outputs::view::MAX_KEY_FRAMES`]).
     pub view: View,
 }
 

@@ -6,6 +6,7 @@
 use nalgebra::{DVector, Isometry3, Vector2, Vector3};
 
 use super::params::TaskParams;
+use super::wrist::WristMoments;
 use super::TaskError;
 use crate::hierarchy::TaskLevel;
 use crate::model::{ModelData, RobotModel};
@@ -88,18 +89,20 @@ pub struct TaskSetup<'a> {
 /// The skin-derived signals of one cycle that the hand, wrist and guidance tasks read.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct HandSignals {
-    /// z of the hand patches' summed force in the hand frame (fused signal units).
-    pub fused_force: f64,
+    /// `F = Σ_i c_i F_i`: the pressed hand cells' newtons along the hand's z axis, eq. (9)'s
+    /// `f_c` in newtons (`skin::measured`).
+    pub force_n: f64,
+    /// Eq. (9)'s `f_c,d` \[N\]: the controller's force reference.
+    pub force_reference_n: f64,
     /// Largest proximity signal of the hand patches.
     pub proximity: f64,
-    /// Summed moment of the hand patches, world axes (eq. 10's `Γ`).
+    /// Summed moment of the hand patches' fused signals (eq. 8), world axes (recorded as
+    /// `ControllerOutput::hand_moment`).
     pub moment_world: Vector3<f64>,
+    /// The moments eq. (10)'s compliant wrist drives to zero, per modality.
+    pub wrist: WristMoments,
     /// Guidance patches' summed force in the hand frame (eq. 11's `h_F`).
     pub guidance_force: Vector3<f64>,
-    /// Desired fused signal `f_c,d` of eq. (9) (signal units): the controller's force
-    /// reference in newtons read through the characteristic with the contact's measured
-    /// distribution over the hand cells (`skin::measured`).
-    pub force_reference: f64,
 }
 
 /// Everything a task may read in one control cycle (kinematics already updated).
@@ -129,6 +132,8 @@ pub struct Cycle<'a> {
     pub scan: &'a [Vector2<f64>],
     /// The commanded base motion with the base joints' model indices.
     pub base_reference: Option<([usize; 3], BaseReference)>,
+    /// The control period of this cycle \[s\].
+    pub dt_s: f64,
 }
 
 /// A task of the control law. Built once ([`Task::build`]), updated every cycle the active

@@ -60,8 +60,8 @@ pub const APPROACH_BRAKE_S: f64 = 0.02;
 
 /// The integral term of the force error stays within this share of the reference: it makes up
 /// the velocity servo's offset (0.1-0.2 N at 6 N), not a rise slowed by an edge of the palm
-/// (windup; measured on the campaign's force family, seed 1: Table 3 met in 20 scenes of 50 with
-/// 0.1, 16 with 0.3 and 1).
+/// (windup; measured on the campaign's force family, seed 1, the wrist's `k` at 20: Table 3 met
+/// in 20 scenes of 50 with 0.1, 16 with 0.3 and 1).
 pub const INTEGRAL_SHARE: f64 = 0.1;
 
 /// The largest closing speed toward a surface sensed `distance_m` ahead \[m/s\]:

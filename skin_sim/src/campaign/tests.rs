@@ -33,11 +33,11 @@ fn a_fixed_obstacle_is_infeasible_and_a_light_slippery_one_feasible() {
     assert!(!families::feasible(&s.spec, EPS_C_N, &pushed), "5.9 N of friction");
 }
 
-/// The hand on a board tilted by 8° about both of its axes touches with an edge of the palm,
-/// where the summed skin signal reads a force low; the controller reads its newton reference
-/// with the contact's measured distribution (`skin_core::skin::measured`), so MuJoCo's force
-/// settles at the reference and the first touch stays within 2 N of it. With the even-press
-/// reference of before, such boards peaked at 6-9 N over the reference (campaign seed 1).
+/// A board tilted by 8° about both of its axes, where an edge of the palm makes the summed skin
+/// signal read a force low: the controller regulates the pressed hand cells' newtons
+/// (`skin_core::skin::measured`), so MuJoCo's force settles at the reference, and the first
+/// touch stays within 2 N of it. With the even-press signal reference of before, such boards
+/// peaked at 6-9 N over the reference (campaign seed 1).
 #[test]
 fn on_a_tilted_board_the_hand_holds_the_reference_in_newtons_without_impact() {
     for tilt_deg in [[8.0, 8.0], [-8.0, 8.0], [8.0, -8.0]] {

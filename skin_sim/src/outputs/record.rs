@@ -54,8 +54,8 @@ pub struct CycleRecord {
     /// Force reference of the scene at this time \[N\] (NaN: none active).
     pub force_reference_n: f64,
     /// The force reference as the hand signal of an even press of the palm, `n f(F/n)`
-    /// (`HandForceMap`; NaN: none). The controller is given the newtons and reads them with the
-    /// contact's measured distribution (`skin_core::skin::measured`).
+    /// (`HandForceMap`; NaN: none), what the paper's summed signal would read. The controller is
+    /// given the newtons and regulates the pressed hand cells' newtons (`skin_core::skin::measured`).
     pub force_reference_signal: f64,
     /// Whether a scripted interaction (push on the robot, a person near the base, scripted base
     /// motion) is going on.

@@ -288,6 +288,7 @@ fn tasks_do_not_allocate_after_setup() {
     use skin_core::tasks::posture::Posture;
     use skin_core::tasks::tactile_guidance::TactileGuidance;
     use skin_core::tasks::wrist::CompliantWrist;
+    use skin_core::tasks::WristMoments;
 
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
     let model = RobotModel::from_urdf_file(&root.join("urdf/tomm.urdf")).unwrap();
@@ -350,8 +351,9 @@ fn tasks_do_not_allocate_after_setup() {
         orient.update(&model, data, &goal_r, l1).unwrap();
         avoid.update(&model, data, &layout, &live, 0.08, l2).unwrap();
         contact.update(&model, data, &layout, &live, &skin.fusion, l3).unwrap();
-        hand_task.update(&model, data, HandMeasurement::Force { fused_signal: 0.1 }, 0.0, &skin.proximity, l4).unwrap();
-        wrist.update(&model, data, &gamma, l5).unwrap();
+        hand_task.update(&model, data, HandMeasurement::Force { force_n: 1.0 }, 0.0, &skin.proximity, l4).unwrap();
+        let moments = WristMoments { proximity_world: gamma, force_world_nm: gamma, fusion_weight: 0.5 };
+        wrist.update(&model, data, &moments, l5).unwrap();
         guide.update(&model, data, &h_f, l6).unwrap();
         hold.update(&model, data, l7).unwrap();
         base.update(&q, &laser).unwrap();

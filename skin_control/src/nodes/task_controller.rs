@@ -798,7 +798,7 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     })?;
     let force = node.subscribe::<Float64>(local(FORCE_REFERENCE), qos::user_input())?;
     spawn_sub(spawner, force, &shared, |s, msg| {
-        let result = s.tc.on_force_reference(msg.data).map(|_| ());
+        let result = s.tc.on_force_reference(msg.data);
         s.refused(result);
     })?;
     let arrangement = node.subscribe::<Arrangement>(local(ARRANGEMENT), qos::latched())?;

@@ -347,7 +347,9 @@ pub struct TaskController {
     cells: CellBuffer,
     scan: ScanConverter,
     no_scan: Vec<Vector2<f64>>,
-    hand_map: Option<HandForceMap>,
+    /// The hand has a palm cell facing along the end effector's z axis ([`HandForceMap`]): a
+    /// force reference means something.
+    hand_senses_force: bool,
     arms: Vec<ArmCommand>,
     needs_odom: bool,
     needs_cells: bool,
@@ -370,7 +372,7 @@ impl TaskController {
         params.validate()?;
         config.skin = params.skin;
         config.tasks = params.tasks.clone();
-        let hand_map = HandForceMap::new(&config);
+        let hand_senses_force = HandForceMap::new(&config).is_some();
         let controller = Controller::new(config, t0_s).map_err(|e| e.to_string())?;
         let cfg = controller.config();
         let model = &cfg.model;
@@ -400,7 +402,7 @@ impl TaskController {
             state,
             scan,
             no_scan: Vec::new(),
-            hand_map,
+            hand_senses_force,
             arms,
             joint_msg_stamp: None,
             last_cycle: None,
@@ -586,22 +588,20 @@ impl TaskController {
         Ok(*frame_pose(&data, frame))
     }
 
-    /// The hand force reference \[N\], mapped to the hand signal `f_c,d` of interactive-force-control paper eq. (9)
-    /// by `skin_core::controller::HandForceMap` (an even contact on the palm cells). Returns the
-    /// signal given.
-    pub fn on_force_reference(&mut self, force_n: f64) -> Result<f64, InputError> {
-        let Some(map) = self.hand_map.as_ref() else {
+    /// The hand force reference `f_c,d` of interactive-force-control paper eq. (9) \[N\] (the
+    /// hand cells' measured newtons, `skin_core::skin::measured`). Refused without a palm cell
+    /// facing along the end effector's z axis.
+    pub fn on_force_reference(&mut self, force_n: f64) -> Result<(), InputError> {
+        if !self.hand_senses_force {
             let why = "the controller setup's hand_patches have no cell facing along the end effector's z axis";
             return Err(self.health.refuse(FORCE_REFERENCE)(why.into()));
         };
         if !(force_n.is_finite() && force_n >= 0.0) {
             return Err(self.health.refuse(FORCE_REFERENCE)(format!("data = {force_n}: must be finite and >= 0 N")));
         }
-        let signal = map.signal(force_n);
         self.controller
-            .set_hand_force_reference(signal)
-            .map_err(|f| self.health.refuse(FORCE_REFERENCE)(f.to_string()))?;
-        Ok(signal)
+            .set_hand_force_reference(force_n)
+            .map_err(|f| self.health.refuse(FORCE_REFERENCE)(f.to_string()))
     }
 
     /// `/supervisor/arrangement` (ignored with `supervisor: internal`; returns whether it was

@@ -9,8 +9,10 @@ use super::task_set::TaskSet;
 use crate::hierarchy::{HierarchySolver, LevelDiagnostics};
 use crate::model::{gravity, point_velocity, update_kinematics, ModelData};
 use crate::resolver::{Commands, Resolver};
-use crate::skin::aggregate::{aggregate_live_patches, FusionParams, PatchWrench};
+use crate::skin::aggregate::{aggregate_live_patch, aggregate_live_patches, FusionParams, PatchWrench};
+use crate::skin::characteristic::PreparedForce;
 use crate::skin::live::LiveCells;
+use crate::skin::measured::measured_contact;
 use crate::skin::transforms::{patch_poses_world, patch_wrench_world, sum_patch_forces_in_frame};
 use crate::supervisor::blend::chi;
 use crate::supervisor::{Arrangement, Imposed, Phase, PhaseRefused, Supervisor, SupervisorInput, TorqueBlender};
@@ -51,8 +53,11 @@ pub struct Controller {
     /// The supervisor's `‖F_d‖` and `‖F_c‖` (whether or not the arrangement has these tasks).
     proximity_signal: ProximityAvoidance,
     contact_signal: ContactReaction,
-    /// Desired fused hand signal `f_c,d` of interactive-force-control paper eq. (9).
-    hand_force_reference: f64,
+    /// Desired hand contact force \[N\]: `f_c,d` of interactive-force-control paper eq. (9),
+    /// regulated in newtons (`skin::measured`).
+    hand_force_reference_n: f64,
+    /// The force characteristic, prepared: the hand cells' newtons (`skin::measured`).
+    force: PreparedForce,
     /// The commanded base motion, if any.
     base_reference: Option<BaseReference>,
     solver: HierarchySolver,
@@ -177,7 +182,8 @@ impl Controller {
             tasks,
             proximity_signal: ProximityAvoidance::new(nv, config.tasks.avoidance),
             contact_signal: ContactReaction::new(nv, config.tasks.contact_reaction, &config.skin.force),
-            hand_force_reference: config.tasks.hand_force.force_signal_desired,
+            hand_force_reference_n: config.tasks.hand_force.force_desired_n,
+            force: config.skin.force.prepared(),
             base_reference: None,
             supervisor,
             config,
@@ -215,17 +221,18 @@ impl Controller {
         self.goal.as_ref()
     }
 
-    /// Sets the desired fused hand signal `f_c,d` of interactive-force-control paper eq. (9): the hand patches' summed
-    /// virtual force along the hand's z axis (eq. 7: a sum over the active cells, so up to the
-    /// number of hand cells), clamped to `[0, hand cells]`; NaN is refused.
-    pub fn set_hand_force_reference(&mut self, signal: f64) -> Result<(), Fault> {
-        if signal.is_nan() {
+    /// Sets the desired hand contact force \[N\] along the hand's z axis, clamped to
+    /// `[0, hand cells × max_n]` (what the hand can sense, each cell up to the saturation of the
+    /// force characteristic); NaN is refused. It is `f_c,d` of interactive-force-control paper
+    /// eq. (9), regulated against the pressed hand cells' newtons (`skin::measured`).
+    pub fn set_hand_force_reference(&mut self, force_n: f64) -> Result<(), Fault> {
+        if force_n.is_nan() {
             return Err(Fault::NonFinite { input: "hand force reference", index: 0 });
         }
         let layout = &self.config.layout;
         let hand_cells: usize =
             layout.patches().iter().zip(&self.hand_patches).filter(|(_, &h)| h).map(|(p, _)| p.cells.len()).sum();
-        self.hand_force_reference = signal.clamp(0.0, hand_cells as f64);
+        self.hand_force_reference_n = force_n.clamp(0.0, hand_cells as f64 * self.config.skin.force.max_n);
         Ok(())
     }
 
@@ -400,8 +407,7 @@ impl Controller {
         let (hand, guidance) = (&self.hand_patches, &self.guidance_patches);
         patch_poses_world(layout, |f| data.frame_pose(f), |j| hand[j] || guidance[j], &mut self.patch_poses);
 
-        let mut hand = self.hand_signals();
-        hand.force_reference = self.hand_force_reference;
+        let hand = self.hand_signals()?;
         self.output.hand_moment = data.frame_pose(self.ee).rotation.inverse_transform_vector(&hand.moment_world);
         self.clock.lap(Stage::Skin);
 
@@ -419,6 +425,7 @@ impl Controller {
             sensing_range_m: arrangement.sensing_range_m,
             scan: input.scan,
             base_reference: self.resolver.base_joints().zip(self.base_reference),
+            dt_s: input.dt_s,
         };
         let order = arrangement.task_order();
         let any_locked = self.locked.contains(&true);
@@ -509,22 +516,34 @@ impl Controller {
         })
     }
 
-    /// Interactive-force-control paper eq. (9)-(11) inputs from the patch wrenches of this cycle.
-    fn hand_signals(&self) -> HandSignals {
+    /// Interactive-force-control paper eq. (9)-(11) inputs from this cycle's skin: the hand's
+    /// force and moment in newtons (`skin::measured`), the proximity signals' moment, the
+    /// guidance patches' force.
+    fn hand_signals(&self) -> Result<HandSignals, Fault> {
         let hand_pose = self.data.frame_pose(self.ee);
         let (poses, wrenches) = (&self.patch_poses, &self.wrenches);
-        let in_hand = sum_patch_forces_in_frame(hand_pose, poses, wrenches, |j| self.hand_patches[j]);
+        let (layout, fusion) = (&self.config.layout, &self.fusion);
+        let z_hand = hand_pose.rotation * nalgebra::Vector3::z();
+        let hand = |j: usize| self.hand_patches[j];
+        let contact = measured_contact(layout, &self.live, &self.force, fusion, &z_hand, poses, hand);
         let mut s = HandSignals {
-            fused_force: in_hand.z,
+            force_n: contact.force_n,
+            force_reference_n: self.hand_force_reference_n,
             guidance_force: sum_patch_forces_in_frame(hand_pose, poses, wrenches, |j| self.guidance_patches[j]),
             ..HandSignals::default()
         };
+        s.wrist.force_world_nm = contact.moment_nm;
+        s.wrist.fusion_weight = fusion.weight_force;
+        let proximity_only = FusionParams { weight_force: 0.0, ..*fusion };
         for (j, (pose, w)) in poses.iter().zip(wrenches).enumerate() {
             if self.hand_patches[j] {
                 s.proximity = s.proximity.max(w.max_proximity_signal);
                 s.moment_world += patch_wrench_world(pose, w).moment;
+                let p =
+                    aggregate_live_patch(layout, &self.live, j, &proximity_only).map_err(stage("skin aggregation"))?;
+                s.wrist.proximity_world += patch_wrench_world(pose, &p).moment;
             }
         }
-        s
+        Ok(s)
     }
 }

@@ -1,20 +1,23 @@
-//! Force references in newtons to the hand signal `f_c,d` of interactive-force-control paper eq. (9).
+//! What the summed hand signal of the interactive-force-control paper reads for a force in
+//! newtons, and whether a hand can sense a contact force at all.
 //!
-//! The controller regulates `f_c`, the z component (hand frame) of the hand patches' force of
+//! The paper's eq. (9) regulates `f_c`, the z component (hand frame) of the hand patches' force of
 //! eq. (7): the sum of the active cells' fused signals along their normals. In the contact phase
 //! the fusion weight is 1, so a cell pressed by `F_i` newtons contributes `f(F_i)`, the force
 //! characteristic of `config/skin_model.yaml` (`f(F) = (1 - e^{-F/s}) / (1 - e^{-F_max/s})`).
 //! A flat contact of `F` newtons shared evenly by the `n` hand cells that face along the palm
-//! normal (what the compliant wrist of eq. (10) aims at: zero moment, the contact distributed)
-//! therefore reads
+//! normal therefore reads
 //!
 //! ```text
 //! f_c(F) = n f(F / n)
 //! ```
 //!
-//! and that is the reference this map gives for `F`. The force characteristic is nonlinear, so
-//! an uneven distribution reads lower for the same force: the measured newtons (MuJoCo's
-//! contacts, measured by skin_sim's probe) tell how good the assumption is.
+//! and that is what this map gives for `F`. The characteristic is nonlinear, so an uneven
+//! distribution (an edge of the palm on a tilted surface) reads lower for the same force: the
+//! controller therefore regulates the measured newtons instead (`skin::measured`, each cell
+//! inverted before the sum), and this map only tells whether a hand has cells facing along its
+//! normal (no force reference without them) and what the paper's summed signal would read
+//! (skin_sim records it beside the newtons).
 
 use super::setup::ControllerConfig;
 use crate::skin::characteristic::PreparedForce;
@@ -23,7 +26,7 @@ use nalgebra::Vector3;
 /// A cell counts as facing along the palm normal when `n_i · z_h` exceeds this (within ~25°).
 const FACING_COS: f64 = 0.9;
 
-/// The map `F \[N\] -> f_c,d` for one controller's hand.
+/// The map `F \[N\] -> n f(F / n)` (the summed signal of an even press) for one controller's hand.
 #[derive(Debug, Clone, Copy)]
 pub struct HandForceMap {
     /// Hand cells facing along the hand's z axis.

@@ -136,10 +136,26 @@ pub fn aggregate_live_patches(
     LengthMismatch::check_count(layout, live.num_cells())?;
     out.resize(layout.patches().len(), PatchWrench::default());
     for (k, w) in out.iter_mut().enumerate() {
-        let live = live.in_range(layout.patches()[k].cells.clone());
-        *w = aggregate_range(layout, k, live.iter().map(|(i, r)| (*i, r)), fusion);
+        *w = live_patch(layout, live, k, fusion);
     }
     Ok(())
+}
+
+/// The wrench of patch `patch` alone from the non-silent cells (as in
+/// [`aggregate_live_patches`]), e.g. with another fusion weight than the cycle's. No allocation.
+pub fn aggregate_live_patch(
+    layout: &ResolvedLayout,
+    live: &LiveCells,
+    patch: usize,
+    fusion: &FusionParams,
+) -> Result<PatchWrench, LengthMismatch> {
+    LengthMismatch::check_count(layout, live.num_cells())?;
+    Ok(live_patch(layout, live, patch, fusion))
+}
+
+fn live_patch(layout: &ResolvedLayout, live: &LiveCells, patch: usize, fusion: &FusionParams) -> PatchWrench {
+    let live = live.in_range(layout.patches()[patch].cells.clone());
+    aggregate_range(layout, patch, live.iter().map(|(i, r)| (*i, r)), fusion)
 }
 
 /// `(cell index, reading)` of the cells of patch `patch`.

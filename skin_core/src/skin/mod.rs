@@ -23,6 +23,7 @@ pub mod generate;
 pub mod layout;
 pub mod live;
 pub mod markers;
+pub mod measured;
 pub mod mesh_tiling;
 pub mod params;
 pub mod repulsion;

@@ -40,7 +40,7 @@ pub mod wrist;
 mod tests;
 
 pub use error::TaskError;
-pub use task::{entry, BaseReference, Cycle, HandSignals, Role, Rows, Task, TaskEntry, TaskSetup};
+pub use task::{entry, BaseReference, Cycle, HandSignals, Role, Rows, Task, TaskEntry, TaskSetup, WristMoments};
 
 /// Every task by its name in `config/supervisor.yaml`. A new task is a file with its `impl Task`,
 /// its `mod` line above and one entry here (`docs/tasks.md`).

@@ -60,15 +60,16 @@ declare_params! {
     pub struct HandForceParams {
         /// Desired inertia `Λ_1`.
         pub lambda_kg: f64 => { unit: "kg", range: Range::positive(1e3), live: false },
-        /// `K_1` in force mode (signal error to task force).
-        pub k_force_n_per_signal: f64 => { unit: "N per signal unit", range: Range::closed(0.0, 1e3), live: false },
+        /// `K_1` in force mode (force error in newtons, read by the pressed hand cells, to task
+        /// force).
+        pub k_force_n_per_n: f64 => { unit: "N/N", range: Range::closed(0.0, 1e3), live: false },
         /// `K_1` in distance mode.
         pub k_distance_n_per_m: f64 => { unit: "N/m", range: Range::closed(0.0, 1e4), live: false },
         /// `D_1`.
         pub d_n_s_per_m: f64 => { unit: "N s/m", range: Range::closed(0.0, 1e4), live: false },
-        /// Desired fused contact signal `f_c,d` (contact phase, Table 1): the hand patch's summed
-        /// virtual force (eq. 7 sums the active cells' signals, so it can exceed 1).
-        pub force_signal_desired: f64 => { unit: "signal", range: Range::closed(0.0, 1e4), live: false },
+        /// Desired contact force `f_c,d` (contact phase, Table 1) until a reference is given,
+        /// regulated against the pressed hand cells' newtons (`skin::measured`).
+        pub force_desired_n: f64 => { unit: "N", range: Range::closed(0.0, 1e3), live: false },
         /// Desired distance `d_p,d` (approach phase, Table 1).
         pub distance_desired_m: f64 => { unit: "m", range: Range::closed(0.0, 1.0), live: false },
         /// Approach speed bound: the hand may close on a sensed surface at most at
@@ -77,6 +78,10 @@ declare_params! {
         pub approach_time_s: f64 => { unit: "s", range: Range::positive(100.0), live: false },
         /// Closing speed still allowed at `d = 0` (touching).
         pub approach_speed_min_mps: f64 => { unit: "m/s", range: Range::positive(1.0), live: false },
+        /// Integral time `T_i` of the force error in contact (`tasks::hand_force`): eq. (9)'s
+        /// error becomes `Δ + (1/T_i) ∫Δ dt` while the hand is pressed, so the force settles at
+        /// the reference against the arm's velocity servo; 0: eq. (9) as printed.
+        pub integral_time_s: f64 => { unit: "s", range: Range::closed(0.0, 1e3), live: false },
     }
 }
 
@@ -92,6 +97,26 @@ declare_params! {
         pub k: [f64; 3] => { unit: "N/m", range: Range::closed(0.0, 1e5), live: false },
         /// Diagonal of `D` (N m s/rad for rotations).
         pub d: [f64; 3] => { unit: "N s/m", range: Range::closed(0.0, 1e4), live: false },
+    }
+}
+
+declare_params! {
+    /// Interactive-force-control paper eq. (10): the compliant wrist,
+    /// `ω̇* = Λ⁻¹(−K Γ − D ω)`, with the moment `Γ` of each sensing modality in its own units,
+    /// weighted as eq. (6) weights the modalities (`tasks::wrist`).
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct WristParams {
+        /// Diagonal of `Λ_2`.
+        pub lambda: [f64; 3] => { unit: "kg m²", range: Range::positive(1e3), live: false },
+        /// Diagonal of `K_2` on the proximity signals' moment (eq. 8 of the proximity signals,
+        /// the precontact phase's alignment before the touch).
+        pub k: [f64; 3] => { unit: "N m per moment unit of the proximity signal", range: Range::closed(0.0, 1e5), live: false },
+        /// Diagonal of `K_2` on the measured moment of the pressed cells' newtons (eq. 8 with
+        /// `F_i = f⁻¹(s_i)`, `skin::measured`): the contact phase's alignment.
+        pub k_force: [f64; 3] => { unit: "N m per N m", range: Range::closed(0.0, 1e5), live: false },
+        /// Diagonal of `D_2`.
+        pub d: [f64; 3] => { unit: "N m s/rad", range: Range::closed(0.0, 1e4), live: false },
     }
 }
 
@@ -168,7 +193,7 @@ declare_params! {
         /// Hand force/distance (interactive-force-control paper eq. 9).
         pub hand_force: HandForceParams => nested,
         /// Compliant wrist (interactive-force-control paper eq. 10).
-        pub wrist: Impedance3 => nested,
+        pub wrist: WristParams => nested,
         /// Tactile guidance (interactive-force-control paper eq. 11-12).
         pub tactile_guidance: Impedance3 => nested,
         /// Cartesian position hold (interactive-force-control paper eq. 4, Table 1).

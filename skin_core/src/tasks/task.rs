@@ -85,19 +85,34 @@ pub struct TaskSetup<'a> {
     pub posture: &'a [f64],
 }
 
+/// The hand moments the wrist reads in one cycle.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct WristMoments {
+    /// `Γ_p`: the hand patches' moment of the proximity signals (eq. 8), world axes.
+    pub proximity_world: Vector3<f64>,
+    /// `Γ_F`: the hand patches' moment of the pressed cells' newtons \[N m\], world axes.
+    pub force_world_nm: Vector3<f64>,
+    /// `w` of eq. (6) this cycle (0: proximity only, 1: force only).
+    pub fusion_weight: f64,
+}
+
 /// The skin-derived signals of one cycle that the hand, wrist and guidance tasks read.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct HandSignals {
-    /// z of the hand patches' summed force in the hand frame (fused signal units).
-    pub fused_force: f64,
+    /// `F = Σ_i c_i F_i`: the pressed hand cells' newtons along the hand's z axis, eq. (9)'s
+    /// `f_c` in newtons (`skin::measured`).
+    pub force_n: f64,
+    /// Eq. (9)'s `f_c,d` \[N\]: the controller's force reference.
+    pub force_reference_n: f64,
     /// Largest proximity signal of the hand patches.
     pub proximity: f64,
-    /// Summed moment of the hand patches, world axes (eq. 10's `Γ`).
+    /// Summed moment of the hand patches' fused signals (eq. 8), world axes (recorded as
+    /// `ControllerOutput::hand_moment`).
     pub moment_world: Vector3<f64>,
+    /// The moments eq. (10)'s compliant wrist drives to zero, per modality.
+    pub wrist: WristMoments,
     /// Guidance patches' summed force in the hand frame (eq. 11's `h_F`).
     pub guidance_force: Vector3<f64>,
-    /// Desired fused signal `f_c,d` of eq. (9) (signal units).
-    pub force_reference: f64,
 }
 
 /// Everything a task may read in one control cycle (kinematics already updated).
@@ -127,6 +142,8 @@ pub struct Cycle<'a> {
     pub scan: &'a [Vector2<f64>],
     /// The commanded base motion with the base joints' model indices.
     pub base_reference: Option<([usize; 3], BaseReference)>,
+    /// The control period of this cycle \[s\].
+    pub dt_s: f64,
 }
 
 /// A task of the control law. Built once ([`Task::build`]), updated every cycle the active

@@ -15,7 +15,8 @@ use super::params::{HandForceParams, TaskParams};
 use super::position_hold::PositionHold;
 use super::posture::Posture;
 use super::tactile_guidance::TactileGuidance;
-use super::task::BaseReference;
+use super::task::WristMoments;
+use super::task::{BaseReference, Task};
 use super::wrist::CompliantWrist;
 use crate::hierarchy::{HierarchySolver, InverseParams, TaskLevel};
 use crate::model::{crba, point_jacobian, update_kinematics, ModelData, RobotModel};
@@ -239,6 +240,7 @@ fn hand_approach_speed_is_bounded_by_the_sensed_distance() {
     // undamped eq. (9), so that only the bound can brake
     let h = HandForceParams { d_n_s_per_m: 0.0, ..s.params.hand_force };
     let mut task = HandForce::new(s.model.nv(), hand, h);
+    task.force_desired_n = 3.0;
     let mut level = TaskLevel::new("hand", s.model.nv(), 1);
     let mut j = Matrix6xX::zeros(s.model.nv());
     point_jacobian(&s.model, &s.data, hand, &Vector3::zeros(), &mut j).unwrap();
@@ -246,7 +248,7 @@ fn hand_approach_speed_is_bounded_by_the_sensed_distance() {
     // joint velocities that move the hand along +z_h at `speed` (least squares through J_v^T)
     let row = (z.transpose() * j.fixed_rows::<3>(0)).transpose();
     let moving = |speed: f64| row.clone() * (speed / row.norm_squared());
-    let far = HandMeasurement::Force { fused_signal: 0.0 };
+    let far = HandMeasurement::Force { force_n: 0.0 };
     let near = s.skin.proximity.signal(0.01);
     let limit_near = super::hand_force::approach_speed_limit(&h, 0.01);
     assert_relative_eq!(limit_near, h.approach_speed_min_mps + 0.01 / h.approach_time_s, epsilon = 1e-9);
@@ -258,7 +260,7 @@ fn hand_approach_speed_is_bounded_by_the_sensed_distance() {
     assert_relative_eq!(xdd, -limit_near / super::hand_force::APPROACH_BRAKE_S, max_relative = 1e-6);
     // the same speed with nothing in range is below the bound: eq. (9) as it is
     let xdd = task.update(&s.model, &s.data, far, 0.0, &s.skin.proximity, &mut level).unwrap();
-    assert_relative_eq!(xdd, h.k_force_n_per_signal * h.force_signal_desired / h.lambda_kg, max_relative = 1e-6);
+    assert_relative_eq!(xdd, h.k_force_n_per_n * task.force_desired_n / h.lambda_kg, max_relative = 1e-6);
     // retreating is never bounded
     let qd = moving(-0.2);
     update_kinematics(&s.model, &mut s.data, &s.q, qd.as_slice()).unwrap();
@@ -271,17 +273,18 @@ fn hand_force_sign_and_row() {
     let s = tomm();
     let hand = s.model.frame_index("right_hand").unwrap();
     let mut task = HandForce::new(s.model.nv(), hand, s.params.hand_force);
+    task.force_desired_n = 3.0;
     let mut level = TaskLevel::new("hand", s.model.nv(), 1);
     // force below the reference: accelerate into the surface (+z_h)
     let xdd = task
-        .update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.0 }, 0.0, &s.skin.proximity, &mut level)
+        .update(&s.model, &s.data, HandMeasurement::Force { force_n: 0.0 }, 0.0, &s.skin.proximity, &mut level)
         .unwrap();
     assert!(xdd > 0.0);
     let h = s.params.hand_force;
-    assert_relative_eq!(xdd, h.k_force_n_per_signal * h.force_signal_desired / h.lambda_kg, epsilon = 1e-12);
+    assert_relative_eq!(xdd, h.k_force_n_per_n * task.force_desired_n / h.lambda_kg, epsilon = 1e-12);
     // too much force: back off
     let xdd = task
-        .update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.9 }, 0.0, &s.skin.proximity, &mut level)
+        .update(&s.model, &s.data, HandMeasurement::Force { force_n: 9.0 }, 0.0, &s.skin.proximity, &mut level)
         .unwrap();
     assert!(xdd < 0.0);
     // far away in distance mode: approach
@@ -306,6 +309,36 @@ fn hand_force_sign_and_row() {
     }
 }
 
+/// The integral of the force error while pressed: it grows with a lasting error (the servo's
+/// offset), up to its share of the reference, and starts again from zero after the hand lets go
+/// and after an arrangement switch.
+#[test]
+fn hand_force_integral_makes_up_a_lasting_offset_within_its_share() {
+    let s = tomm();
+    let hand = s.model.frame_index("right_hand").unwrap();
+    let h = HandForceParams { integral_time_s: 1.0, ..s.params.hand_force };
+    let mut task = HandForce::new(s.model.nv(), hand, h);
+    task.force_desired_n = 6.0;
+    let under = HandMeasurement::Force { force_n: 5.9 };
+    let p = |task: &HandForce| task.error(under, &s.skin.proximity);
+    let proportional = p(&task);
+    assert_relative_eq!(proportional, h.k_force_n_per_n * 0.1, epsilon = 1e-12);
+    for _ in 0..125 {
+        task.integrate(5.9, 0.008); // 1 s of 0.1 N under the reference
+    }
+    assert_relative_eq!(p(&task), 2.0 * proportional, epsilon = 1e-9);
+    for _ in 0..1000 {
+        task.integrate(5.9, 0.008);
+    }
+    let share = super::hand_force::INTEGRAL_SHARE;
+    assert_relative_eq!(p(&task), proportional + h.k_force_n_per_n * share * 6.0, epsilon = 1e-9);
+    task.integrate(0.0, 0.008); // let go
+    assert_relative_eq!(p(&task), proportional, epsilon = 1e-12);
+    task.integrate(5.9, 0.8);
+    task.on_switch(&s.data);
+    assert_relative_eq!(p(&task), proportional, epsilon = 1e-12);
+}
+
 #[test]
 fn wrist_drives_moment_to_zero() {
     let s = tomm();
@@ -313,10 +346,17 @@ fn wrist_drives_moment_to_zero() {
     let mut task = CompliantWrist::new(s.model.nv(), hand, s.params.wrist);
     let mut level = TaskLevel::new("wrist", s.model.nv(), 3);
     let gamma = Vector3::new(0.0, 0.4, -0.1);
-    let a = task.update(&s.model, &s.data, &gamma, &mut level).unwrap();
+    let proximity = WristMoments { proximity_world: gamma, ..WristMoments::default() };
+    let a = task.update(&s.model, &s.data, &proximity, &mut level).unwrap();
     assert_eq!(level.rows(), 3);
     assert!(a.dot(&gamma) < 0.0);
-    assert!(task.update(&s.model, &s.data, &Vector3::zeros(), &mut level).unwrap().norm() < 1e-12);
+    assert!(task.update(&s.model, &s.data, &WristMoments::default(), &mut level).unwrap().norm() < 1e-12);
+    // in contact (w = 1) the newtons' moment drives it, the proximity's no longer
+    let contact = WristMoments { proximity_world: gamma, force_world_nm: -gamma, fusion_weight: 1.0 };
+    let b = task.update(&s.model, &s.data, &contact, &mut level).unwrap();
+    assert!(b.dot(&gamma) > 0.0);
+    let k = s.params.wrist.k_force;
+    assert_relative_eq!(b, Vector3::from_fn(|i, _| k[i] * gamma[i] / s.params.wrist.lambda[i]), epsilon = 1e-12);
 }
 
 #[test]
@@ -457,9 +497,7 @@ fn three_tasks_and_posture_through_the_solver() {
         .update(&s.model, &s.data, &s.layout, &LiveCells::from_readings(&readings, &s.skin.proximity), 0.1, l0)
         .unwrap();
     assert!(sum.rows > 0);
-    hand_task
-        .update(&s.model, &s.data, HandMeasurement::Force { fused_signal: 0.1 }, 0.0, &s.skin.proximity, l1)
-        .unwrap();
+    hand_task.update(&s.model, &s.data, HandMeasurement::Force { force_n: 1.0 }, 0.0, &s.skin.proximity, l1).unwrap();
     hold.update(&s.model, &s.data, l2).unwrap();
     let (mut tau_s, mut tau_c) = (DVector::zeros(nv), DVector::zeros(nv));
     compliance.add_to(&s.model, &s.data, &s.layout, &wrenches, |_| true, &mut tau_s).unwrap();

@@ -53,7 +53,9 @@ pub struct CycleRecord {
     pub hand_moment: [f64; 3],
     /// Force reference of the scene at this time \[N\] (NaN: none active).
     pub force_reference_n: f64,
-    /// The hand signal reference `f_c,d` given to the controller (NaN: none).
+    /// The force reference as the hand signal of an even press of the palm, `n f(F/n)`
+    /// (`HandForceMap`; NaN: none), what the paper's summed signal would read. The controller is
+    /// given the newtons and regulates the pressed hand cells' newtons (`skin_core::skin::measured`).
     pub force_reference_signal: f64,
     /// Whether a scripted interaction (push on the robot, a person near the base, scripted base
     /// motion) is going on.

@@ -1,6 +1,6 @@
 //! What the scene tells the controller over time: the active end-effector goal (`goals`), the
-//! force reference (`force_references`, newtons turned into the hand signal by
-//! [`HandForceMap`]), the commanded base motion (`base_motions`, [`BaseMotions`]) and, for interactive-force-control paper's phase policy, the switch to the contact phase when
+//! force reference (`force_references`, in newtons; [`HandForceMap`] checks the hand can sense one
+//! and gives its even-press signal for the record), the commanded base motion (`base_motions`, [`BaseMotions`]) and, for interactive-force-control paper's phase policy, the switch to the contact phase when
 //! the first force reference starts (interactive-force-control paper Sec. 4.2.2: "the contact phase is manually
 //! activated by the user"; the scene's `start_s` is that moment).
 
@@ -27,7 +27,8 @@ pub struct ScheduleError {
 pub struct ScheduledInputs {
     /// Force reference \[N\] (NaN: none active).
     pub force_n: f64,
-    /// The hand signal given for it (NaN: none).
+    /// Its hand signal for an even press of the palm (`HandForceMap`, recorded beside it; NaN:
+    /// none). The controller is given the newtons.
     pub force_signal: f64,
 }
 
@@ -112,7 +113,7 @@ impl Schedule {
     }
 
     /// Gives `controller` what the scene asks for at `t_s` with the robot measured at `q` (model
-    /// order): the goal that started last, the force reference as a hand signal, the base
+    /// order): the goal that started last, the force reference in newtons, the base
     /// motion's reference, the contact phase once it is due.
     pub fn apply(&mut self, t_s: f64, q: &[f64], controller: &mut Controller) -> Result<ScheduledInputs, Fault> {
         let goal = latest(&self.goals, |g| g.start_s, t_s);
@@ -124,7 +125,7 @@ impl Schedule {
         if let (Some(k), Some(map)) = (latest(&self.forces, |f| f.start_s, t_s), &self.map) {
             inputs.force_n = self.forces[k].value(t_s);
             inputs.force_signal = map.signal(inputs.force_n);
-            controller.set_hand_force_reference(inputs.force_signal)?;
+            controller.set_hand_force_reference(inputs.force_n)?;
         }
         if let Some(b) = self.base {
             let reference = self.motions.reference(t_s, b.map(|j| q[j]));

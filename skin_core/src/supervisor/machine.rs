@@ -321,9 +321,10 @@ impl Supervisor {
                         }
                         return;
                     }
-                    // Stopped: slower than ε_v, or crawling without getting nearer the goal
-                    // (a NaN speed is never stopped).
-                    let crawl = self.progress.step(t, ge, th.progress_window_s, th.progress_min_m) && !v.is_nan();
+                    // Stopped: slower than ε_v, or crawling toward the goal slower than
+                    // `crawl_speed_mps` (a NaN speed is never stopped).
+                    let crawl_min_m = th.crawl_speed_mps * th.progress_window_s;
+                    let crawl = self.progress.step(t, ge, th.progress_window_s, crawl_min_m) && !v.is_nan();
                     let set = (v <= th.speed_mps || crawl)
                         && fd > th.obstacle_force_n + th.obstacle_band_n
                         && ge > th.goal_tolerance_m + th.goal_band_m;

@@ -79,11 +79,15 @@ declare_params! {
         pub goal_tolerance_m: f64 => { unit: "m", range: Range::positive(1.0), live: false },
         /// The goal counts as not reached for the stuck test when the error is `>` tol + band.
         pub goal_band_m: f64 => { unit: "m", range: Range::closed(0.0, 1.0), live: false },
-        /// Window of the progress test: moving but not getting nearer the goal (a crawl along an
-        /// obstacle faster than ε_v) counts as stopped when the goal error fell by less than
-        /// `progress_min_m` over this long.
+        /// Window of the crawl test: moving but hardly getting nearer the goal (a crawl along an
+        /// obstacle faster than ε_v) counts as stopped when the goal error fell slower than
+        /// `crawl_speed_mps` on average over this long.
         pub progress_window_s: f64 => { unit: "s", range: Range::positive(100.0), live: false },
-        /// Least fall of the goal error over `progress_window_s` that counts as progress.
+        /// A crawl: the goal error fell by less than `crawl_speed_mps · progress_window_s` over
+        /// the last window of (a).
+        pub crawl_speed_mps: f64 => { unit: "m/s", range: Range::closed(0.0, 1.0), live: false },
+        /// Least fall of the goal error that counts as progress of a push (its retry) or of a
+        /// blocked hold (its end).
         pub progress_min_m: f64 => { unit: "m", range: Range::closed(0.0, 1.0), live: false },
     }
 }

@@ -725,27 +725,33 @@ fn follower_reproduces_the_deciding_supervisor() {
     assert!(s.impose(bad).is_err());
 }
 
-/// A crawl along an obstacle, faster than ε_v but not getting nearer the goal, counts as stuck
-/// after the progress window (and the stuck dwell); the same speed with the goal error falling
-/// faster than `progress_min_m` per window never does.
+/// A crawl along an obstacle, faster than ε_v but getting nearer the goal slower than
+/// `crawl_speed_mps`, counts as stuck after the progress window (and the stuck dwell); the same
+/// speed with the goal error falling twice as fast as `crawl_speed_mps` never does.
 #[test]
 fn a_crawl_without_goal_progress_is_stuck() {
     let p = params();
     let th = p.thresholds;
-    let crawl_speed = 3.0 * th.speed_mps;
+    let speed = 5.0 * th.speed_mps;
     let mut sup = Supervisor::new(&p, 0.0).unwrap();
     let mut t = 0.0;
     let steps = |s: f64| (s / DT).ceil() as usize;
-    // the goal error falls by 2 progress_min_m per window: progress
-    let rate = 2.0 * th.progress_min_m / th.progress_window_s;
+    // the goal error falls at twice the crawl speed: progress
+    let rate = 2.0 * th.crawl_speed_mps;
+    assert!(rate < speed, "the goal cannot come nearer faster than the end effector moves");
     for _ in 0..steps(4.0 * th.progress_window_s) {
         t += DT;
-        sup.update(t, &input(crawl_speed, 3.0, 0.0, 0.5 - rate * t));
+        sup.update(t, &input(speed, 3.0, 0.0, 1.0 - rate * t));
         assert_eq!(sup.last_transition(), None, "progress is not a local minimum (t = {t})");
     }
-    // then it crawls at the same speed without progress
-    let tr =
-        run(&mut sup, &mut t, steps(2.0 * th.progress_window_s + p.dwell.stuck_s), input(crawl_speed, 3.0, 0.0, 0.3));
+    // then it crawls at the same speed, the goal error falling at half the crawl speed
+    let (t0, e0) = (t, 1.0 - rate * t);
+    let mut tr = Vec::new();
+    for _ in 0..steps(2.0 * th.progress_window_s + p.dwell.stuck_s) {
+        t += DT;
+        sup.update(t, &input(speed, 3.0, 0.0, e0 - 0.5 * th.crawl_speed_mps * (t - t0)));
+        tr.extend(sup.last_transition());
+    }
     assert_eq!(tr.len(), 1, "{tr:?}");
     assert_eq!((tr[0].to, tr[0].cause), (Mode::IntentionalContact, Cause::Stuck));
 }

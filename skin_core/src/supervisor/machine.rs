@@ -361,8 +361,12 @@ impl Supervisor {
             }
             Mode::HardContact => {
                 self.hard_peak_n = if fc.is_nan() { f64::INFINITY } else { self.hard_peak_n.max(fc) };
-                if self.released.step(t, below, below, dw.contact_release_s) {
-                    if self.resume == Mode::IntentionalContact && self.retry {
+                // Back to (b) when the force is below ε_c − band (Table I (b): `‖F_c‖ < ε_c`);
+                // back to (a) only when the contact is gone (Table I (a): `‖F_c‖ = 0`).
+                let to_b = self.resume == Mode::IntentionalContact && self.retry;
+                let released = if to_b { below } else { fc <= th.contact_zero_n }; // NaN: never
+                if self.released.step(t, released, released, dw.contact_release_s) {
+                    if to_b {
                         // The obstacle gave way before the push reached ε_c: push on.
                         self.switch(t, Mode::IntentionalContact, Cause::ContactReleased);
                     } else if self.resume == Mode::IntentionalContact {

@@ -71,6 +71,9 @@ declare_params! {
         /// Hard contact is left only when `‖F_c‖ < ε_c − band`; below `contact_force_n` (else
         /// hard contact is never left).
         pub contact_band_n: f64 => { unit: "N", range: Range::closed(0.0, 1e3), live: false },
+        /// No contact (Table I (a): `‖F_c‖ = 0`) when `‖F_c‖ ≤` this: (c) is left for (a) only
+        /// then (for (b): below `contact_force_n − contact_band_n`). Above the skin's noise floor.
+        pub contact_zero_n: f64 => { unit: "N", range: Range::closed(0.0, 1e3), live: false },
         /// Nothing in range when `‖F_d‖ ≤` this (0: exactly no repulsion, as in Table I).
         pub obstacle_force_n: f64 => { unit: "N", range: Range::closed(0.0, 1e3), live: false },
         /// An obstacle counts as in range for the stuck test when `‖F_d‖ >` threshold + band.
@@ -236,6 +239,14 @@ impl SupervisorParams {
                 key: "thresholds.contact_band_n".into(),
                 value: t.contact_band_n,
                 reason: "must be < contact_force_n (else hard contact is never left)".into(),
+            }
+            .into());
+        }
+        if t.contact_zero_n >= t.contact_force_n {
+            return Err(InvalidParam {
+                key: "thresholds.contact_zero_n".into(),
+                value: t.contact_zero_n,
+                reason: "must be < contact_force_n (no contact is below the hard-contact limit)".into(),
             }
             .into());
         }

@@ -127,8 +127,10 @@ fn contact_over_limit_in_b_goes_to_c_and_the_push_is_given_up() {
     // Below eps_c but inside the band: stays in (c).
     assert!(run(&mut sup, &mut t, 500, input(0.0, 0.0, 4.0, 0.2)).is_empty());
     assert_eq!(sup.blocked(), None);
-    // Below eps_c - band, for the dwell: the push of (b) reached eps_c, so back to (a), blocked.
-    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 2.0, 0.2));
+    // Below eps_c - band but still pressing: no (a) (Table I (a): no contact).
+    assert!(run(&mut sup, &mut t, 200, input(0.0, 3.0, 2.0, 0.2)).is_empty());
+    // The contact gone, for the dwell: the push of (b) reached eps_c, so back to (a), blocked.
+    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
     assert_eq!(tr.len(), 1);
     assert_eq!((tr[0].from, tr[0].to, tr[0].cause), (Mode::HardContact, Mode::Avoidance, Cause::PushBlocked));
     let b = sup.blocked().expect("blocked");
@@ -231,6 +233,22 @@ fn hard_contact_from_a_returns_to_a() {
     let tr = run(&mut sup, &mut t, 1, input(0.1, 0.0, 5.0, 0.2));
     assert_eq!((tr[0].from, tr[0].to), (Mode::Avoidance, Mode::HardContact));
     let tr = run(&mut sup, &mut t, 200, input(0.1, 0.0, 0.0, 0.2));
+    assert_eq!((tr[0].from, tr[0].to), (Mode::HardContact, Mode::Avoidance));
+}
+
+/// Table I (a) needs `‖F_c‖ = 0`: a hard contact is left for (a) only when the contact is gone
+/// (`contact_zero_n`), not while the arm still presses below `ε_c − band`.
+#[test]
+fn hard_contact_is_left_for_a_only_without_contact() {
+    let p = params();
+    let th = p.thresholds;
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    run(&mut sup, &mut t, 1, input(0.1, 0.0, th.contact_force_n, 0.2));
+    assert_eq!(sup.mode(), Mode::HardContact);
+    let pressing = 0.5 * (th.contact_zero_n + th.contact_force_n - th.contact_band_n);
+    assert!(run(&mut sup, &mut t, 500, input(0.1, 0.0, pressing, 0.2)).is_empty(), "still in contact");
+    let tr = run(&mut sup, &mut t, 200, input(0.1, 0.0, th.contact_zero_n, 0.2));
     assert_eq!((tr[0].from, tr[0].to), (Mode::HardContact, Mode::Avoidance));
 }
 

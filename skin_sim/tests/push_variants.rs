@@ -152,5 +152,7 @@ fn removing_contact_reaction_fails_the_fixed_obstacle_scene() {
     let report = without.run(&Default::default(), |_| {}).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
     let failed: Vec<&str> = report.checks.iter().filter(|c| !c.passed).map(|c| c.name).collect();
-    assert_eq!(failed, ["peak contact force (outside pushes)"], "{:?}", report.checks);
+    // (Without the reaction the arm keeps pressing, so (c) is not left for the blocked hold
+    // either: the outcome check may fail too.)
+    assert!(failed.contains(&"peak contact force (outside pushes)"), "{:?}", report.checks);
 }

@@ -321,9 +321,10 @@ impl Supervisor {
                         }
                         return;
                     }
-                    // Stopped: slower than ε_v, or crawling without getting nearer the goal
-                    // (a NaN speed is never stopped).
-                    let crawl = self.progress.step(t, ge, th.progress_window_s, th.progress_min_m) && !v.is_nan();
+                    // Stopped: slower than ε_v, or crawling toward the goal slower than
+                    // `crawl_speed_mps` (a NaN speed is never stopped).
+                    let crawl_min_m = th.crawl_speed_mps * th.progress_window_s;
+                    let crawl = self.progress.step(t, ge, th.progress_window_s, crawl_min_m) && !v.is_nan();
                     let set = (v <= th.speed_mps || crawl)
                         && fd > th.obstacle_force_n + th.obstacle_band_n
                         && ge > th.goal_tolerance_m + th.goal_band_m;
@@ -360,8 +361,12 @@ impl Supervisor {
             }
             Mode::HardContact => {
                 self.hard_peak_n = if fc.is_nan() { f64::INFINITY } else { self.hard_peak_n.max(fc) };
-                if self.released.step(t, below, below, dw.contact_release_s) {
-                    if self.resume == Mode::IntentionalContact && self.retry {
+                // Back to (b) when the force is below ε_c − band (Table I (b): `‖F_c‖ < ε_c`);
+                // back to (a) only when the contact is gone (Table I (a): `‖F_c‖ = 0`).
+                let to_b = self.resume == Mode::IntentionalContact && self.retry;
+                let released = if to_b { below } else { fc <= th.contact_zero_n }; // NaN: never
+                if self.released.step(t, released, released, dw.contact_release_s) {
+                    if to_b {
                         // The obstacle gave way before the push reached ε_c: push on.
                         self.switch(t, Mode::IntentionalContact, Cause::ContactReleased);
                     } else if self.resume == Mode::IntentionalContact {

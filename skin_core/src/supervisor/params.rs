@@ -71,6 +71,9 @@ declare_params! {
         /// Hard contact is left only when `‖F_c‖ < ε_c − band`; below `contact_force_n` (else
         /// hard contact is never left).
         pub contact_band_n: f64 => { unit: "N", range: Range::closed(0.0, 1e3), live: false },
+        /// No contact (Table I (a): `‖F_c‖ = 0`) when `‖F_c‖ ≤` this: (c) is left for (a) only
+        /// then (for (b): below `contact_force_n − contact_band_n`). Above the skin's noise floor.
+        pub contact_zero_n: f64 => { unit: "N", range: Range::closed(0.0, 1e3), live: false },
         /// Nothing in range when `‖F_d‖ ≤` this (0: exactly no repulsion, as in Table I).
         pub obstacle_force_n: f64 => { unit: "N", range: Range::closed(0.0, 1e3), live: false },
         /// An obstacle counts as in range for the stuck test when `‖F_d‖ >` threshold + band.
@@ -79,11 +82,15 @@ declare_params! {
         pub goal_tolerance_m: f64 => { unit: "m", range: Range::positive(1.0), live: false },
         /// The goal counts as not reached for the stuck test when the error is `>` tol + band.
         pub goal_band_m: f64 => { unit: "m", range: Range::closed(0.0, 1.0), live: false },
-        /// Window of the progress test: moving but not getting nearer the goal (a crawl along an
-        /// obstacle faster than ε_v) counts as stopped when the goal error fell by less than
-        /// `progress_min_m` over this long.
+        /// Window of the crawl test: moving but hardly getting nearer the goal (a crawl along an
+        /// obstacle faster than ε_v) counts as stopped when the goal error fell slower than
+        /// `crawl_speed_mps` on average over this long.
         pub progress_window_s: f64 => { unit: "s", range: Range::positive(100.0), live: false },
-        /// Least fall of the goal error over `progress_window_s` that counts as progress.
+        /// A crawl: the goal error fell by less than `crawl_speed_mps · progress_window_s` over
+        /// the last window of (a).
+        pub crawl_speed_mps: f64 => { unit: "m/s", range: Range::closed(0.0, 1.0), live: false },
+        /// Least fall of the goal error that counts as progress of a push (its retry) or of a
+        /// blocked hold (its end).
         pub progress_min_m: f64 => { unit: "m", range: Range::closed(0.0, 1.0), live: false },
     }
 }
@@ -232,6 +239,14 @@ impl SupervisorParams {
                 key: "thresholds.contact_band_n".into(),
                 value: t.contact_band_n,
                 reason: "must be < contact_force_n (else hard contact is never left)".into(),
+            }
+            .into());
+        }
+        if t.contact_zero_n >= t.contact_force_n {
+            return Err(InvalidParam {
+                key: "thresholds.contact_zero_n".into(),
+                value: t.contact_zero_n,
+                reason: "must be < contact_force_n (no contact is below the hard-contact limit)".into(),
             }
             .into());
         }

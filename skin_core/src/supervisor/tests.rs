@@ -127,8 +127,10 @@ fn contact_over_limit_in_b_goes_to_c_and_the_push_is_given_up() {
     // Below eps_c but inside the band: stays in (c).
     assert!(run(&mut sup, &mut t, 500, input(0.0, 0.0, 4.0, 0.2)).is_empty());
     assert_eq!(sup.blocked(), None);
-    // Below eps_c - band, for the dwell: the push of (b) reached eps_c, so back to (a), blocked.
-    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 2.0, 0.2));
+    // Below eps_c - band but still pressing: no (a) (Table I (a): no contact).
+    assert!(run(&mut sup, &mut t, 200, input(0.0, 3.0, 2.0, 0.2)).is_empty());
+    // The contact gone, for the dwell: the push of (b) reached eps_c, so back to (a), blocked.
+    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
     assert_eq!(tr.len(), 1);
     assert_eq!((tr[0].from, tr[0].to, tr[0].cause), (Mode::HardContact, Mode::Avoidance, Cause::PushBlocked));
     let b = sup.blocked().expect("blocked");
@@ -231,6 +233,22 @@ fn hard_contact_from_a_returns_to_a() {
     let tr = run(&mut sup, &mut t, 1, input(0.1, 0.0, 5.0, 0.2));
     assert_eq!((tr[0].from, tr[0].to), (Mode::Avoidance, Mode::HardContact));
     let tr = run(&mut sup, &mut t, 200, input(0.1, 0.0, 0.0, 0.2));
+    assert_eq!((tr[0].from, tr[0].to), (Mode::HardContact, Mode::Avoidance));
+}
+
+/// Table I (a) needs `‖F_c‖ = 0`: a hard contact is left for (a) only when the contact is gone
+/// (`contact_zero_n`), not while the arm still presses below `ε_c − band`.
+#[test]
+fn hard_contact_is_left_for_a_only_without_contact() {
+    let p = params();
+    let th = p.thresholds;
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let mut t = 0.0;
+    run(&mut sup, &mut t, 1, input(0.1, 0.0, th.contact_force_n, 0.2));
+    assert_eq!(sup.mode(), Mode::HardContact);
+    let pressing = 0.5 * (th.contact_zero_n + th.contact_force_n - th.contact_band_n);
+    assert!(run(&mut sup, &mut t, 500, input(0.1, 0.0, pressing, 0.2)).is_empty(), "still in contact");
+    let tr = run(&mut sup, &mut t, 200, input(0.1, 0.0, th.contact_zero_n, 0.2));
     assert_eq!((tr[0].from, tr[0].to), (Mode::HardContact, Mode::Avoidance));
 }
 
@@ -725,27 +743,33 @@ fn follower_reproduces_the_deciding_supervisor() {
     assert!(s.impose(bad).is_err());
 }
 
-/// A crawl along an obstacle, faster than ε_v but not getting nearer the goal, counts as stuck
-/// after the progress window (and the stuck dwell); the same speed with the goal error falling
-/// faster than `progress_min_m` per window never does.
+/// A crawl along an obstacle, faster than ε_v but getting nearer the goal slower than
+/// `crawl_speed_mps`, counts as stuck after the progress window (and the stuck dwell); the same
+/// speed with the goal error falling twice as fast as `crawl_speed_mps` never does.
 #[test]
 fn a_crawl_without_goal_progress_is_stuck() {
     let p = params();
     let th = p.thresholds;
-    let crawl_speed = 3.0 * th.speed_mps;
+    let speed = 5.0 * th.speed_mps;
     let mut sup = Supervisor::new(&p, 0.0).unwrap();
     let mut t = 0.0;
     let steps = |s: f64| (s / DT).ceil() as usize;
-    // the goal error falls by 2 progress_min_m per window: progress
-    let rate = 2.0 * th.progress_min_m / th.progress_window_s;
+    // the goal error falls at twice the crawl speed: progress
+    let rate = 2.0 * th.crawl_speed_mps;
+    assert!(rate < speed, "the goal cannot come nearer faster than the end effector moves");
     for _ in 0..steps(4.0 * th.progress_window_s) {
         t += DT;
-        sup.update(t, &input(crawl_speed, 3.0, 0.0, 0.5 - rate * t));
+        sup.update(t, &input(speed, 3.0, 0.0, 1.0 - rate * t));
         assert_eq!(sup.last_transition(), None, "progress is not a local minimum (t = {t})");
     }
-    // then it crawls at the same speed without progress
-    let tr =
-        run(&mut sup, &mut t, steps(2.0 * th.progress_window_s + p.dwell.stuck_s), input(crawl_speed, 3.0, 0.0, 0.3));
+    // then it crawls at the same speed, the goal error falling at half the crawl speed
+    let (t0, e0) = (t, 1.0 - rate * t);
+    let mut tr = Vec::new();
+    for _ in 0..steps(2.0 * th.progress_window_s + p.dwell.stuck_s) {
+        t += DT;
+        sup.update(t, &input(speed, 3.0, 0.0, e0 - 0.5 * th.crawl_speed_mps * (t - t0)));
+        tr.extend(sup.last_transition());
+    }
     assert_eq!(tr.len(), 1, "{tr:?}");
     assert_eq!((tr[0].to, tr[0].cause), (Mode::IntentionalContact, Cause::Stuck));
 }

@@ -80,7 +80,8 @@ pub struct PhaseRefused {
 pub struct SupervisorInput {
     /// `‖ẋ‖` of the end effector \[m/s\].
     pub ee_speed_mps: f64,
-    /// `‖F_d‖`, the largest skin repulsion force \[N\], computed with the NOMINAL sensing range
+    /// `‖F_d‖`, the Euclidean norm over the cells' repulsion forces `F_di` of eq. (3) (not the
+    /// largest one) \[N\], computed with the NOMINAL sensing range
     /// (otherwise shrinking the range in (b) would itself read as "nothing in range").
     pub avoidance_force_n: f64,
     /// `‖F_c‖`, the largest skin contact force \[N\].

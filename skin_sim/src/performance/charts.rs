@@ -72,8 +72,8 @@ pub fn stacked(series: &Series, path: &Path) -> anyhow::Result<()> {
 /// loop, with the real-time factor over each bar.
 pub fn loop_parts(points: &[SimPoint], path: &Path) -> anyhow::Result<()> {
     font().map_err(err)?;
-    let top = points.iter().map(|p| p.ms_per_s.iter().sum::<f64>()).fold(0.0, f64::max) * 1.15;
-    let root = BitMapBackend::new(path, (900, 520)).into_drawing_area();
+    let top = points.iter().map(|p| p.ms_per_s.iter().sum::<f64>()).fold(0.0, f64::max) * 1.35;
+    let root = BitMapBackend::new(path, (1200, 520)).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
     let mut chart = ChartBuilder::on(&root)
         .caption("Wall time per simulated second, by part of the loop", (FONT, 19))
@@ -86,7 +86,7 @@ pub fn loop_parts(points: &[SimPoint], path: &Path) -> anyhow::Result<()> {
         .configure_mesh()
         .disable_x_mesh()
         .y_desc("wall time [ms] per simulated s")
-        .label_style((FONT, 11))
+        .label_style((FONT, 10))
         .axis_desc_style((FONT, 13))
         .x_labels(points.len())
         .x_label_formatter(&|v| {
@@ -118,6 +118,6 @@ pub fn loop_parts(points: &[SimPoint], path: &Path) -> anyhow::Result<()> {
             Text::new(format!("{:.0}x", p.realtime_factor), (i as f64 - 0.15, total + top * 0.01), (FONT, 12))
         }))
         .map_err(err)?;
-    legend(&mut chart, SeriesLabelPosition::UpperRight).map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperLeft).map_err(err)?;
     root.present().map_err(err)
 }

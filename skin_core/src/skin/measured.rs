@@ -29,54 +29,6 @@ use super::characteristic::PreparedForce;
 use super::layout::ResolvedLayout;
 use super::live::LiveCells;
 
-/// A pressed cell as [`pressed_cells`] visits it.
-struct Pressed {
-    /// `c_i`: the cell's outward normal along the axis.
-    along_axis: f64,
-    /// `F_i = f⁻¹(s_i)` \[N\].
-    force_n: f64,
-    /// `t_i × n_i` in the patch frame \[m\] (the lever of eq. 8).
-    lever: Vector3<f64>,
-    /// Its patch (layout order).
-    patch: usize,
-}
-
-/// Calls `visit(cell)` for every pressed cell (force signal above `fusion.activity_threshold`,
-/// reduced per `fusion.force_reduction`) of the patches `include(j)` selects, `c_i` along `axis`
-/// (world coordinates). `patch_poses` as from [`super::transforms::patch_poses_world`] (those of
-/// the included patches up to date).
-#[allow(clippy::too_many_arguments)]
-fn pressed_cells(
-    layout: &ResolvedLayout,
-    live: &LiveCells,
-    force: &PreparedForce,
-    fusion: &FusionParams,
-    axis: &Vector3<f64>,
-    patch_poses: &[Isometry3<f64>],
-    include: impl Fn(usize) -> bool,
-    mut visit: impl FnMut(Pressed),
-) {
-    for (j, (patch, pose)) in layout.patches().iter().zip(patch_poses).enumerate() {
-        if !include(j) {
-            continue;
-        }
-        let axis_in_patch = pose.rotation.inverse_transform_vector(axis);
-        let geometry = &layout.patch_geometry[patch.cells.clone()];
-        for (i, r) in live.in_range(patch.cells.clone()) {
-            let s = r.force_signal(fusion.force_reduction);
-            if s > fusion.activity_threshold {
-                let g = &geometry[i - patch.cells.start];
-                visit(Pressed {
-                    along_axis: g.normal.dot(&axis_in_patch),
-                    force_n: force.force_n(s),
-                    lever: g.lever,
-                    patch: j,
-                });
-            }
-        }
-    }
-}
-
 /// The hand's contact as the force sensing reads it (module doc).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeasuredContact {
@@ -88,7 +40,10 @@ pub struct MeasuredContact {
     pub moment_nm: Vector3<f64>,
 }
 
-/// The contact the patches `include(j)` selects measure along `axis` (module doc). No
+/// The contact the patches `include(j)` selects measure along `axis` (module doc): every pressed
+/// cell (force signal above `fusion.activity_threshold`, reduced per `fusion.force_reduction`)
+/// with `c_i` along `axis` (world coordinates). `patch_poses` as from
+/// [`super::transforms::patch_poses_world`] (those of the included patches up to date). No
 /// allocation.
 pub fn measured_contact(
     layout: &ResolvedLayout,
@@ -100,10 +55,22 @@ pub fn measured_contact(
     include: impl Fn(usize) -> bool,
 ) -> MeasuredContact {
     let mut c = MeasuredContact { force_n: 0.0, moment_nm: Vector3::zeros() };
-    pressed_cells(layout, live, force, fusion, axis, patch_poses, include, |p| {
-        c.force_n += p.along_axis * p.force_n;
-        c.moment_nm += patch_poses[p.patch].rotation * (p.lever * p.force_n);
-    });
+    for (j, (patch, pose)) in layout.patches().iter().zip(patch_poses).enumerate() {
+        if !include(j) {
+            continue;
+        }
+        let axis_in_patch = pose.rotation.inverse_transform_vector(axis);
+        let geometry = &layout.patch_geometry[patch.cells.clone()];
+        for (i, r) in live.in_range(patch.cells.clone()) {
+            let s = r.force_signal(fusion.force_reduction);
+            if s > fusion.activity_threshold {
+                let g = &geometry[i - patch.cells.start];
+                let f_i = force.force_n(s);
+                c.force_n += g.normal.dot(&axis_in_patch) * f_i; // c_i F_i
+                c.moment_nm += pose.rotation * (g.lever * f_i); // R_j (t_i × n_i) F_i
+            }
+        }
+    }
     c
 }
 

@@ -3,7 +3,9 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use super::{cdr, BagError, RosMessage};
+use super::cdr;
+use super::error::BagError;
+use super::msgs::RosMessage;
 
 /// One message of a bag, still CDR encoded.
 #[derive(Debug, Clone)]

@@ -5,7 +5,9 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
-use super::{cdr, defs, BagError, RosMessage};
+use super::error::BagError;
+use super::msgs::RosMessage;
+use super::{cdr, defs};
 
 /// The offered QoS of a latched publisher (reliable, transient local, depth 1) in rosbag2's YAML,
 /// for [`BagWriter::add_topic`]: a player re-offers it, so late subscribers (RViz's robot model

@@ -268,6 +268,7 @@ pub fn read_patch_array(
             active_cells: p.active_cells as usize,
             max_force_signal: f64::from(p.max_force),
             max_proximity_signal: f64::from(p.max_proximity),
+            proximity_moment: Vector3::zeros(), // not in the message; the controller aggregates its own
         };
         let finite = |v: &Vector3<f64>| v.iter().all(|c| c.is_finite());
         let checks = [

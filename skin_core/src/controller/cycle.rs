@@ -9,7 +9,7 @@ use super::task_set::TaskSet;
 use crate::hierarchy::{HierarchySolver, LevelDiagnostics};
 use crate::model::{gravity, point_velocity, update_kinematics, ModelData};
 use crate::resolver::{Commands, Resolver};
-use crate::skin::aggregate::{aggregate_live_patch, aggregate_live_patches, FusionParams, PatchWrench};
+use crate::skin::aggregate::{aggregate_live_patches, FusionParams, PatchWrench};
 use crate::skin::characteristic::PreparedForce;
 use crate::skin::live::LiveCells;
 use crate::skin::measured::measured_contact;
@@ -407,7 +407,7 @@ impl Controller {
         let (hand, guidance) = (&self.hand_patches, &self.guidance_patches);
         patch_poses_world(layout, |f| data.frame_pose(f), |j| hand[j] || guidance[j], &mut self.patch_poses);
 
-        let hand = self.hand_signals()?;
+        let hand = self.hand_signals();
         self.output.hand_moment = data.frame_pose(self.ee).rotation.inverse_transform_vector(&hand.moment_world);
         self.clock.lap(Stage::Skin);
 
@@ -519,7 +519,7 @@ impl Controller {
     /// Interactive-force-control paper eq. (9)-(11) inputs from this cycle's skin: the hand's
     /// force and moment in newtons (`skin::measured`), the proximity signals' moment, the
     /// guidance patches' force.
-    fn hand_signals(&self) -> Result<HandSignals, Fault> {
+    fn hand_signals(&self) -> HandSignals {
         let hand_pose = self.data.frame_pose(self.ee);
         let (poses, wrenches) = (&self.patch_poses, &self.wrenches);
         let (layout, fusion) = (&self.config.layout, &self.fusion);
@@ -534,16 +534,13 @@ impl Controller {
         };
         s.wrist.force_world_nm = contact.moment_nm;
         s.wrist.fusion_weight = fusion.weight_force;
-        let proximity_only = FusionParams { weight_force: 0.0, ..*fusion };
         for (j, (pose, w)) in poses.iter().zip(wrenches).enumerate() {
             if self.hand_patches[j] {
                 s.proximity = s.proximity.max(w.max_proximity_signal);
                 s.moment_world += patch_wrench_world(pose, w).moment;
-                let p =
-                    aggregate_live_patch(layout, &self.live, j, &proximity_only).map_err(stage("skin aggregation"))?;
-                s.wrist.proximity_world += patch_wrench_world(pose, &p).moment;
+                s.wrist.proximity_world += pose.rotation * w.proximity_moment;
             }
         }
-        Ok(s)
+        s
     }
 }

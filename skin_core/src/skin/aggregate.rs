@@ -94,6 +94,9 @@ pub struct PatchWrench {
     pub max_force_signal: f64,
     /// Largest proximity signal over all cells of the patch (active or not).
     pub max_proximity_signal: f64,
+    /// Eq. (8) of the proximity signals alone (as with `weight_force` 0), in the patch frame:
+    /// the moment the compliant wrist turns the palm by before the touch (eq. 10).
+    pub proximity_moment: Vector3<f64>,
 }
 
 /// Aggregates the cells of patch `patch` (index into `layout.patches()`) into its wrench
@@ -136,26 +139,10 @@ pub fn aggregate_live_patches(
     LengthMismatch::check_count(layout, live.num_cells())?;
     out.resize(layout.patches().len(), PatchWrench::default());
     for (k, w) in out.iter_mut().enumerate() {
-        *w = live_patch(layout, live, k, fusion);
+        let live = live.in_range(layout.patches()[k].cells.clone());
+        *w = aggregate_range(layout, k, live.iter().map(|(i, r)| (*i, r)), fusion);
     }
     Ok(())
-}
-
-/// The wrench of patch `patch` alone from the non-silent cells (as in
-/// [`aggregate_live_patches`]), e.g. with another fusion weight than the cycle's. No allocation.
-pub fn aggregate_live_patch(
-    layout: &ResolvedLayout,
-    live: &LiveCells,
-    patch: usize,
-    fusion: &FusionParams,
-) -> Result<PatchWrench, LengthMismatch> {
-    LengthMismatch::check_count(layout, live.num_cells())?;
-    Ok(live_patch(layout, live, patch, fusion))
-}
-
-fn live_patch(layout: &ResolvedLayout, live: &LiveCells, patch: usize, fusion: &FusionParams) -> PatchWrench {
-    let live = live.in_range(layout.patches()[patch].cells.clone());
-    aggregate_range(layout, patch, live.iter().map(|(i, r)| (*i, r)), fusion)
 }
 
 /// `(cell index, reading)` of the cells of patch `patch`.
@@ -190,6 +177,9 @@ fn aggregate_range<'a>(
         let p = r.proximity_signal();
         w.max_force_signal = w.max_force_signal.max(f);
         w.max_proximity_signal = w.max_proximity_signal.max(p);
+        if p > fusion.activity_threshold {
+            w.proximity_moment += g.lever * p;
+        }
         // Interactive-force-control paper eq. (6).
         let s = wf * f + wp * p;
         if s > fusion.activity_threshold {

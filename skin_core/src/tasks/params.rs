@@ -82,6 +82,10 @@ declare_params! {
         /// error becomes `Δ + (1/T_i) ∫Δ dt` while the hand is pressed, so the force settles at
         /// the reference against the arm's velocity servo; 0: eq. (9) as printed.
         pub integral_time_s: f64 => { unit: "s", range: Range::closed(0.0, 1e3), live: false },
+        /// Lead `T_l` on the force reference (`tasks::hand_force`): eq. (9)'s force error is
+        /// taken against `f_c,d + T_l ḟ_c,d`, making up the loop's lag behind a moving
+        /// reference; 0: eq. (9) as printed.
+        pub reference_lead_s: f64 => { unit: "s", range: Range::closed(0.0, 10.0), live: false },
     }
 }
 

@@ -258,6 +258,12 @@ fn hand_approach_speed_is_bounded_by_the_sensed_distance() {
     let xdd = task.update(&s.model, &s.data, far, near, &s.skin.proximity, &mut level).unwrap();
     assert!(xdd < 0.0, "braking expected, got {xdd}");
     assert_relative_eq!(xdd, -limit_near / super::hand_force::APPROACH_BRAKE_S, max_relative = 1e-6);
+    // untouched and at rest with a surface in range: closes at the bound, whatever the reference
+    update_kinematics(&s.model, &mut s.data, &s.q, &vec![0.0; s.model.nv()]).unwrap();
+    let xdd = task.update(&s.model, &s.data, far, near, &s.skin.proximity, &mut level).unwrap();
+    assert_relative_eq!(xdd, limit_near / super::hand_force::APPROACH_BRAKE_S, max_relative = 1e-6);
+    let qd = moving(2.0 * limit_near);
+    update_kinematics(&s.model, &mut s.data, &s.q, qd.as_slice()).unwrap();
     // the same speed with nothing in range is below the bound: eq. (9) as it is
     let xdd = task.update(&s.model, &s.data, far, 0.0, &s.skin.proximity, &mut level).unwrap();
     assert_relative_eq!(xdd, h.k_force_n_per_n * task.force_desired_n / h.lambda_kg, max_relative = 1e-6);
@@ -316,7 +322,7 @@ fn hand_force_sign_and_row() {
 fn hand_force_integral_makes_up_a_lasting_offset_within_its_share() {
     let s = tomm();
     let hand = s.model.frame_index("right_hand").unwrap();
-    let h = HandForceParams { integral_time_s: 1.0, ..s.params.hand_force };
+    let h = HandForceParams { integral_time_s: 1.0, reference_lead_s: 0.0, ..s.params.hand_force };
     let mut task = HandForce::new(s.model.nv(), hand, h);
     task.force_desired_n = 6.0;
     let under = HandMeasurement::Force { force_n: 5.9 };
@@ -324,10 +330,10 @@ fn hand_force_integral_makes_up_a_lasting_offset_within_its_share() {
     let proportional = p(&task);
     assert_relative_eq!(proportional, h.k_force_n_per_n * 0.1, epsilon = 1e-12);
     for _ in 0..125 {
-        task.integrate(5.9, 0.008); // 1 s of 0.1 N under the reference
+        task.integrate(5.9, 0.008); // 1 s of 0.1 N under the reference (settled: within the band)
     }
     assert_relative_eq!(p(&task), 2.0 * proportional, epsilon = 1e-9);
-    for _ in 0..1000 {
+    for _ in 0..5000 {
         task.integrate(5.9, 0.008);
     }
     let share = super::hand_force::INTEGRAL_SHARE;
@@ -337,6 +343,48 @@ fn hand_force_integral_makes_up_a_lasting_offset_within_its_share() {
     task.integrate(5.9, 0.8);
     task.on_switch(&s.data);
     assert_relative_eq!(p(&task), proportional, epsilon = 1e-12);
+}
+
+/// During the rise (the force not yet within the band of its reference) the integral's term
+/// stays within the small rise share; once the force has come near, the settled share applies.
+#[test]
+fn hand_force_integral_is_small_during_the_rise() {
+    let s = tomm();
+    let hand = s.model.frame_index("right_hand").unwrap();
+    let h = HandForceParams { integral_time_s: 1.0, reference_lead_s: 0.0, ..s.params.hand_force };
+    let mut task = HandForce::new(s.model.nv(), hand, h);
+    task.force_desired_n = 6.0;
+    let integral =
+        |task: &HandForce| task.error(HandMeasurement::Force { force_n: 6.0 }, &s.skin.proximity) / h.k_force_n_per_n;
+    for _ in 0..1000 {
+        task.integrate(3.0, 0.008); // 8 s at half the reference
+    }
+    assert_relative_eq!(integral(&task), super::hand_force::RISE_INTEGRAL_SHARE * 6.0, epsilon = 1e-9);
+    let band = super::hand_force::INTEGRAL_BAND;
+    task.integrate(6.0 * (1.0 - 0.5 * band), 0.008); // within the band: settled
+    for _ in 0..1000 {
+        task.integrate(3.0, 0.008); // a base pushes the hand off: the large share
+    }
+    assert_relative_eq!(integral(&task), super::hand_force::INTEGRAL_SHARE * 6.0, epsilon = 1e-9);
+}
+
+/// The force error is taken against the led reference `f_c,d + T_l ḟ_c,d`, the rate from the
+/// references of consecutive cycles; an arrangement switch forgets the last one.
+#[test]
+fn hand_force_leads_a_moving_reference() {
+    let s = tomm();
+    let hand = s.model.frame_index("right_hand").unwrap();
+    let h = HandForceParams { integral_time_s: 0.0, reference_lead_s: 0.1, ..s.params.hand_force };
+    let mut task = HandForce::new(s.model.nv(), hand, h);
+    let cycle = |task: &mut HandForce, reference: f64| {
+        task.set_reference(reference, 0.008);
+        task.error(HandMeasurement::Force { force_n: 4.0 }, &s.skin.proximity) / h.k_force_n_per_n
+    };
+    assert_relative_eq!(cycle(&mut task, 4.0), 0.0, epsilon = 1e-12); // no rate yet
+                                                                      // rising at 1 N/s: led by 0.1 N
+    assert_relative_eq!(cycle(&mut task, 4.008), 0.008 + 0.1, epsilon = 1e-9);
+    task.on_switch(&s.data);
+    assert_relative_eq!(cycle(&mut task, 5.0), 1.0, epsilon = 1e-12);
 }
 
 #[test]

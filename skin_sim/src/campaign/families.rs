@@ -1,6 +1,7 @@
 //! The randomized scene families of the campaign, each a shipped scenario's scene varied from a
 //! seed: what the controller was not tuned on.
 
+use nalgebra::{Rotation3, Vector3};
 use serde_json::{json, Value};
 
 use crate::scene::spec::{ObjectSpec, SceneSpec, ShapeSpec};
@@ -130,7 +131,7 @@ fn force_tracking(rng: &mut Noise, spec: &mut SceneSpec) -> Value {
     let radius = rng.between(0.0, 0.3);
     let r = &mut spec.force_references[0];
     (r.mean_n, r.amplitude_n, r.period_s) = (mean, amplitude, Some(period));
-    spec.objects[0].rpy = [0.0, pitch.to_radians(), yaw.to_radians()];
+    tilt_about(&mut spec.objects[0], PALM_HEIGHT_M, [0.0, pitch.to_radians(), yaw.to_radians()]);
     spec.base_motions.truncate(1);
     spec.duration_s = 45.0;
     let m = &mut spec.base_motions[0];
@@ -140,6 +141,30 @@ fn force_tracking(rng: &mut Noise, spec: &mut SceneSpec) -> Value {
     }
     spec.seed = rng.uniform().to_bits() % 1000;
     json!({"mean_n": mean, "amplitude_n": amplitude, "period_s": period, "tilt_deg": [pitch, yaw], "circle_radius_m": radius})
+}
+
+/// Height of the palm in `force_tracking_base_motion` \[m\] (its scene: the hand at (0.8, -0.3, 1.0)).
+pub(super) const PALM_HEIGHT_M: f64 = 1.0;
+
+/// Turns a board (a box, its face toward `-x` in its frame) to the orientation `rpy` about the
+/// point of that face at `height_m` in front of the hand, not about its centre: a tilt changes the
+/// surface's direction, not its distance from the palm (about the centre, 10° moved the face 5 cm
+/// into the hand, which started the run pressed at 90 N). The board may be turned already.
+pub(super) fn tilt_about(board: &mut ObjectSpec, height_m: f64, rpy: [f64; 3]) {
+    let ShapeSpec::Box { size_m } = board.shape else { return };
+    let (centre, turned) = (Vector3::from(board.xyz), rotation(board.rpy));
+    // the face's point on the board's centre line at the palm's height, in the board frame
+    let face = Vector3::new(-0.5 * size_m[0], 0.0, 0.0);
+    let up = (height_m - centre.z - (turned * face).z) / turned[(2, 2)];
+    let point = face + Vector3::new(0.0, 0.0, up);
+    let pivot = centre + turned * point;
+    board.xyz = (pivot - rotation(rpy) * point).into();
+    board.rpy = rpy;
+}
+
+/// The rotation of URDF roll-pitch-yaw angles.
+fn rotation(rpy: [f64; 3]) -> Rotation3<f64> {
+    Rotation3::from_euler_angles(rpy[0], rpy[1], rpy[2])
 }
 
 /// Touches on the arm guide the hand (interactive-force-control paper Exp. 2): which link is
@@ -166,4 +191,22 @@ fn tactile_guidance(rng: &mut Noise, spec: &mut SceneSpec) -> Value {
     }
     spec.seed = rng.uniform().to_bits() % 1000;
     json!({ "touches": drawn })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_tilted_board_keeps_its_face_point_in_front_of_the_palm() {
+        let shape = ShapeSpec::Box { size_m: [0.04, 1.2, 1.0] };
+        let mut board: ObjectSpec =
+            serde_json::from_value(json!({"name": "board", "shape": shape, "xyz": [0.87, -0.3, 0.7]})).unwrap();
+        let face_point = |b: &ObjectSpec| Vector3::from(b.xyz) + rotation(b.rpy) * Vector3::new(-0.02, 0.0, 0.3);
+        for rpy in [[0.0, 10f64.to_radians(), -8f64.to_radians()], [0.0, -8f64.to_radians(), 8f64.to_radians()]] {
+            tilt_about(&mut board, 1.0, rpy); // the second time from the first tilt
+            assert!((face_point(&board) - Vector3::new(0.85, -0.3, 1.0)).norm() < 1e-12, "{rpy:?}");
+        }
+        assert_ne!(board.xyz, [0.87, -0.3, 0.7], "the centre moves");
+    }
 }

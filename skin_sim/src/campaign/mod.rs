@@ -229,8 +229,8 @@ pub fn robustness_md(results: &[SceneResult], s: &Summary) -> String {
          (`skin_sim/src/campaign/families.rs`): planar intentional contact (obstacle position, size,\n\
          mass 0.2-3 kg or fixed, friction, a second obstacle, start posture, goal, skin noise), TOMM\n\
          reaching over a table (obstacle shifts, masses, friction), force tracking (reference mean\n\
-         2-8 N, amplitude, period 2-8 s, board tilt ±10°, base circle radius) and tactile guidance\n\
-         (touched link, force, time).\n\n\
+         2-8 N, amplitude, period 2-8 s, board tilt ±10° about its point in front of the palm, base\n\
+         circle radius) and tactile guidance (touched link, force, time).\n\n\
          A safety violation (`skin_sim::outputs::safety`, the definition every scene check uses) is a\n\
          non-finite command, a safe-stop cycle, an arm joint over its URDF velocity limit, a contact\n\
          above eps_c (in a force scene's contact phase: above the reference + 2 N) for more than\n\

@@ -44,7 +44,8 @@ fn on_a_tilted_board_the_hand_holds_the_reference_in_newtons_without_impact() {
         let mut s = scene(1, 2).unwrap();
         let r = &mut s.spec.force_references[0];
         (r.mean_n, r.amplitude_n) = (5.0, 0.0);
-        s.spec.objects[0].rpy = [0.0, f64::to_radians(tilt_deg[0]), f64::to_radians(tilt_deg[1])];
+        let rpy = [0.0, f64::to_radians(tilt_deg[0]), f64::to_radians(tilt_deg[1])];
+        families::tilt_about(&mut s.spec.objects[0], families::PALM_HEIGHT_M, rpy);
         s.spec.base_motions.clear();
         s.spec.duration_s = 30.0;
         let text = serde_json::to_string(&s.spec).unwrap();

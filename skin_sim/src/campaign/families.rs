@@ -41,13 +41,15 @@ pub const FAMILIES: [Family; 4] = [
     Family { name: "tactile_guidance", scenario: "tactile_guidance", vary: tactile_guidance, obstacles: &[] },
 ];
 
-/// Whether every movable object of `spec` slides under `eps_c` (Coulomb friction `μ m g`), and
-/// none is fixed: the goal is then reachable by pushing (intentional-contact paper Sec. IV).
-pub fn feasible(spec: &SceneSpec, eps_c_n: f64, pushed: &[&str]) -> bool {
+/// The largest Coulomb friction `μ m g` among the objects of `spec` named in `pushed`, what a
+/// push must overcome \[N\]: infinite if one is fixed, 0 without any. Under `ε_c` the goal is
+/// reachable by pushing (intentional-contact paper Sec. IV).
+pub fn resistance_n(spec: &SceneSpec, pushed: &[&str]) -> f64 {
     spec.objects
         .iter()
         .filter(|o| pushed.contains(&o.name.as_str()))
-        .all(|o| o.mass_kg.is_some_and(|m| o.friction * m * G < eps_c_n))
+        .map(|o| o.mass_kg.map_or(f64::INFINITY, |m| o.friction * m * G))
+        .fold(0.0, f64::max)
 }
 
 /// Movable with probability `1 - p_fixed`: a mass in `[lo, hi]` kg, or fixed (`None`).

@@ -17,7 +17,16 @@ fn one_scene_per_family_runs_and_is_judged() {
         assert!(r.verdict.is_some() && r.metrics.is_some());
     }
     assert_eq!(summary.scenes, FAMILIES.len());
-    assert!(robustness_md(&results, &summary).contains("| planar_contact | 1 |"));
+    let md = robustness_md(&results, &summary, "robustness");
+    assert!(md.contains("| planar_contact | 1 |") && md.contains("](robustness/goals.png)"));
+    let dir = std::env::temp_dir().join(format!("skin_campaign_charts_{}", std::process::id()));
+    let files = write(&dir, Some(&dir.join("page.md")), &results, &summary).unwrap();
+    for name in ["page/goals.png", "page/forces.png"] {
+        let f = dir.join(name);
+        assert!(files.contains(&f) && std::fs::metadata(&f).unwrap().len() > 10_000, "{name}: a drawn figure");
+    }
+    assert!(files.contains(&dir.join("page.md")));
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -25,12 +34,13 @@ fn a_fixed_obstacle_is_infeasible_and_a_light_slippery_one_feasible() {
     let mut s = scene(1, 0).unwrap();
     s.spec.objects[0].mass_kg = None;
     let pushed = ["obstacle"];
-    assert!(!families::feasible(&s.spec, EPS_C_N, &pushed));
+    assert_eq!(families::resistance_n(&s.spec, &pushed), f64::INFINITY);
     s.spec.objects[0].mass_kg = Some(0.5);
     s.spec.objects[0].friction = 0.2;
-    assert!(families::feasible(&s.spec, EPS_C_N, &pushed), "0.98 N of friction");
+    assert!((families::resistance_n(&s.spec, &pushed) - 0.981).abs() < 1e-9, "0.98 N of friction");
     s.spec.objects[0].mass_kg = Some(3.0);
-    assert!(!families::feasible(&s.spec, EPS_C_N, &pushed), "5.9 N of friction");
+    assert!(families::resistance_n(&s.spec, &pushed) > EPS_C_N, "5.9 N of friction");
+    assert_eq!(families::resistance_n(&s.spec, &[]), 0.0, "nothing pushed");
 }
 
 /// A board tilted by 8° about both of its axes, where an edge of the palm makes the summed skin

@@ -12,7 +12,8 @@ use anyhow::anyhow;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
-use super::{SceneResult, EPS_C_N};
+use super::families::EPS_C_N;
+use super::result::SceneResult;
 use crate::outputs::outcome::FIRST_CONTACT_OVERSHOOT_N;
 use crate::outputs::plot::{font, legend, FONT, PALETTE};
 

@@ -10,6 +10,9 @@ use crate::world::noise::Noise;
 /// Standard gravity \[m/s²\].
 const G: f64 = 9.81;
 
+/// `ε_c` the feasibility of a push is judged with \[N\] (config/supervisor.yaml).
+pub const EPS_C_N: f64 = 5.0;
+
 /// A scene family.
 #[derive(Debug, Clone, Copy)]
 pub struct Family {

@@ -5,6 +5,7 @@
 
 pub mod charts;
 pub mod families;
+mod result;
 pub mod verdict;
 
 #[cfg(test)]
@@ -24,11 +25,9 @@ use crate::scene::spec::SceneSpec;
 use crate::scene::Scene;
 use crate::study::pool;
 use crate::world::noise::Noise;
-use families::{Family, FAMILIES};
-use verdict::{judge, overshoot_ok, Verdict};
-
-/// `ε_c` the feasibility of a push is judged with \[N\] (config/supervisor.yaml).
-const EPS_C_N: f64 = 5.0;
+use families::{Family, EPS_C_N, FAMILIES};
+pub use result::SceneResult;
+use verdict::{judge, overshoot_ok};
 
 /// One generated scene.
 #[derive(Debug, Clone)]
@@ -60,29 +59,6 @@ pub fn scene(seed: u64, id: usize) -> Result<CampaignScene, String> {
     let resistance_n = families::resistance_n(&spec, family.obstacles);
     let feasible = !spec.goals.is_empty() && resistance_n < EPS_C_N;
     Ok(CampaignScene { id, family, drawn, resistance_n, feasible, target, spec })
-}
-
-/// One scene's row of `results.json`.
-#[derive(Debug, Clone, Serialize)]
-pub struct SceneResult {
-    /// Index in the campaign.
-    pub id: usize,
-    /// Family name.
-    pub family: &'static str,
-    /// What was drawn.
-    pub drawn: Value,
-    /// The largest friction a push must overcome \[N\] (null: a fixed obstacle).
-    pub resistance_n: f64,
-    /// Whether the goal can be reached by pushing under `ε_c`.
-    pub feasible: bool,
-    /// The run failed to start (a scene error) or ran.
-    pub error: Option<String>,
-    /// What it showed.
-    pub verdict: Option<Verdict>,
-    /// Its metrics.
-    pub metrics: Option<Value>,
-    /// Wall-clock time of the run \[s\].
-    pub wall_s: f64,
 }
 
 /// Runs `s`; `out`: also write the run's own outputs there.

@@ -26,6 +26,7 @@ pub mod compliance;
 pub mod contact_reaction;
 mod error;
 pub mod goal;
+pub mod goal_integral;
 pub mod hand_force;
 pub mod params;
 mod point_rows;

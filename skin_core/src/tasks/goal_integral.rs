@@ -12,11 +12,12 @@
 //! - grows only in Table I (b), the one arrangement that pushes, and is zero in every other one
 //!   (each (b) starts from zero: nothing wound up in (a) or in the hard contact (c) is carried
 //!   into a push) and on a new goal;
-//! - grows only while eq. (9) does not saturate, `‖ẋ_d‖ ≤ V_max` with the integrated error
-//!   (conditional integration): the push at rest, `k_v ‖ẋ_d‖`, therefore never exceeds eq. (9)'s
-//!   saturated push `k_v V_max`, which `config/tasks.yaml` keeps below `ε_c` (Sec. III: light
-//!   objects are pushed below `ε_c`). The integral is a force bounded like the push it adds to,
-//!   not a new source of force.
+//! - keeps within what the error leaves before eq. (9) saturates, `‖(1/T_i) ∫ e dt‖ ≤
+//!   V_max k_v / k_p − ‖e‖` (scaled back to it, not frozen: a component along a blocked direction
+//!   does not stop the others from settling; zero far from the goal): `‖ẋ_d‖ ≤ V_max`, so the push
+//!   at rest, `k_v ‖ẋ_d‖`, never exceeds eq. (9)'s saturated push `k_v V_max`, which
+//!   `config/tasks.yaml` keeps below `ε_c` (Sec. III: light objects are pushed below `ε_c`). The
+//!   integral is a force bounded like the push it adds to, not a new source of force.
 
 use nalgebra::Vector3;
 
@@ -41,8 +42,8 @@ impl GoalIntegral {
     }
 
     /// Integrates the error `e` toward `goal` over a cycle of `dt_s` while `pushing` (Table I
-    /// (b)), and only as long as eq. (9) does not saturate with the result (module doc); back to
-    /// zero when not pushing, with `T_i` = 0, or on a new goal.
+    /// (b)), within what `e` leaves before eq. (9) saturates (module doc); back to zero when not
+    /// pushing, with `T_i` = 0, or on a new goal.
     pub fn integrate(&mut self, params: &GoalParams, e: &Vector3<f64>, goal: &Vector3<f64>, dt_s: f64, pushing: bool) {
         let t_i = params.integral_time_s;
         let active = pushing && t_i > 0.0;
@@ -52,10 +53,12 @@ impl GoalIntegral {
         if !active {
             return;
         }
+        // eq. (9) saturates at ‖e + (1/T_i) ∫e‖ = V_max k_v / k_p: the integral keeps to what
+        // the error leaves of it (nothing far from the goal), scaled back rather than frozen, so
+        // its free components still settle when one is blocked.
+        let room = (params.v_max_m_per_s * params.kv_n_s_per_m / params.kp_n_per_m - e.norm()).max(0.0);
         let sum = self.sum + e * dt_s;
-        let xd_dot = (e + sum / t_i) * (params.kp_n_per_m / params.kv_n_s_per_m);
-        if xd_dot.norm() <= params.v_max_m_per_s {
-            self.sum = sum;
-        }
+        let term = sum.norm() / t_i;
+        self.sum = if term > room { sum * (room / term) } else { sum };
     }
 }

@@ -422,7 +422,6 @@ impl Controller {
             body_patches: &self.body_patches,
             hand,
             goal: self.goal.as_ref(),
-            mode: arrangement.mode,
             sensing_range_m: arrangement.sensing_range_m,
             scan: input.scan,
             base_reference: self.resolver.base_joints().zip(self.base_reference),

@@ -4,20 +4,16 @@
 //! [`GoalPosition`] uses the 3 linear rows of the point Jacobian (world axes; a planar robot
 //! simply has a zero row out of its plane, which the rank-aware inverse tolerates).
 //! [`GoalOrientation`] applies the same law to the 3 angular rows with the orientation error
-//! `e = axis·angle(R_d Rᵀ)` (world axes) in place of `x_d − x`. In intentional contact (Table I
-//! (b)) both add the error's integral to `e` ([`super::goal_integral`]), so a push against
-//! friction settles on the goal.
+//! `e = axis·angle(R_d Rᵀ)` (world axes) in place of `x_d − x`.
 
 use nalgebra::{Matrix6xX, UnitQuaternion, Vector3};
 
 use super::error::TaskError;
-use super::goal_integral::GoalIntegral;
 use super::params::GoalParams;
 use super::task::{Cycle, Role, Rows, Task, TaskSetup};
 use super::terms::rows_times_qd;
 use crate::hierarchy::{Reference, TaskLevel};
 use crate::model::{point_jacobian, ModelData, RobotModel};
-use crate::supervisor::Mode;
 
 /// Eq. (7)-(9) on a 3-vector error: returns `F_g` for the error `e = x_d − x` and velocity `v`.
 pub fn saturated_goal_force(params: &GoalParams, error: &Vector3<f64>, velocity: &Vector3<f64>) -> Vector3<f64> {
@@ -36,10 +32,6 @@ pub struct GoalPosition {
     pub point: Vector3<f64>,
     /// Gains and speed limit.
     pub params: GoalParams,
-    /// `∫ e dt` in intentional contact.
-    integral: GoalIntegral,
-    /// `e = x_d − x` of the last update.
-    error: Vector3<f64>,
     jac: Matrix6xX<f64>,
     force: Vector3<f64>,
 }
@@ -47,19 +39,11 @@ pub struct GoalPosition {
 impl GoalPosition {
     /// A goal task for `point` of `frame` on a model with `nv` joints.
     pub fn new(nv: usize, frame: usize, point: Vector3<f64>, params: GoalParams) -> Self {
-        Self {
-            frame,
-            point,
-            params,
-            integral: GoalIntegral::default(),
-            error: Vector3::zeros(),
-            jac: Matrix6xX::zeros(nv),
-            force: Vector3::zeros(),
-        }
+        Self { frame, point, params, jac: Matrix6xX::zeros(nv), force: Vector3::zeros() }
     }
 
     /// Fills `level` (3 rows, [`Reference::Force`]) for the goal `x_d` (world) at the state of the
-    /// last `update_kinematics`, the error with its integral so far. Returns `F_g`.
+    /// last `update_kinematics`. Returns `F_g`.
     pub fn update(
         &mut self,
         model: &RobotModel,
@@ -70,8 +54,7 @@ impl GoalPosition {
         point_jacobian(model, data, self.frame, &self.point, &mut self.jac)?;
         let x = data.frame_pose(self.frame) * nalgebra::Point3::from(self.point);
         let v = rows_times_qd(&self.jac, 0, data.qd());
-        self.error = x_d - x.coords;
-        self.force = saturated_goal_force(&self.params, &self.integral.error(&self.params, &self.error), &v);
+        self.force = saturated_goal_force(&self.params, &(x_d - x.coords), &v);
         level.set(&self.jac.fixed_rows::<3>(0), Reference::Force { f: self.force.as_slice() })?;
         Ok(self.force)
     }
@@ -84,10 +67,6 @@ pub struct GoalOrientation {
     pub frame: usize,
     /// Gains (N m/rad, N m s/rad) and angular speed limit (rad/s).
     pub params: GoalParams,
-    /// `∫ e dt` in intentional contact.
-    integral: GoalIntegral,
-    /// The orientation error of the last update.
-    error: Vector3<f64>,
     jac: Matrix6xX<f64>,
     moment: Vector3<f64>,
 }
@@ -95,18 +74,11 @@ pub struct GoalOrientation {
 impl GoalOrientation {
     /// An orientation goal task for `frame` on a model with `nv` joints.
     pub fn new(nv: usize, frame: usize, params: GoalParams) -> Self {
-        Self {
-            frame,
-            params,
-            integral: GoalIntegral::default(),
-            error: Vector3::zeros(),
-            jac: Matrix6xX::zeros(nv),
-            moment: Vector3::zeros(),
-        }
+        Self { frame, params, jac: Matrix6xX::zeros(nv), moment: Vector3::zeros() }
     }
 
     /// Fills `level` (3 angular rows, [`Reference::Force`]) for the desired world orientation
-    /// `r_d`, the error with its integral so far; returns the task moment.
+    /// `r_d`; returns the task moment.
     pub fn update(
         &mut self,
         model: &RobotModel,
@@ -117,9 +89,9 @@ impl GoalOrientation {
         point_jacobian(model, data, self.frame, &Vector3::zeros(), &mut self.jac)?;
         let r = data.frame_pose(self.frame).rotation;
         // R_d Rᵀ: the world-frame rotation that takes the current orientation to the goal.
-        self.error = (r_d * r.inverse()).scaled_axis();
+        let error = (r_d * r.inverse()).scaled_axis();
         let w = rows_times_qd(&self.jac, 3, data.qd());
-        self.moment = saturated_goal_force(&self.params, &self.integral.error(&self.params, &self.error), &w);
+        self.moment = saturated_goal_force(&self.params, &error, &w);
         level.set(&self.jac.fixed_rows::<3>(3), Reference::Force { f: self.moment.as_slice() })?;
         Ok(self.moment)
     }
@@ -138,14 +110,12 @@ impl Task for GoalPosition {
         Ok(Self::new(s.model.nv(), s.end_effector, Vector3::zeros(), s.params.goal))
     }
 
-    /// Empty without a goal; integrates the error in intentional contact.
+    /// Empty without a goal.
     fn fill(&mut self, cx: &Cycle, level: &mut TaskLevel) -> Result<(), TaskError> {
-        let Some(goal) = cx.goal else { return Ok(()) };
-        let x_d = goal.translation.vector;
-        self.update(cx.model, cx.data, &x_d, level)?;
-        let pushing = cx.mode == Mode::IntentionalContact;
-        self.integral.integrate(&self.params, &self.error, &x_d, cx.dt_s, pushing);
-        Ok(())
+        match cx.goal {
+            Some(goal) => self.update(cx.model, cx.data, &goal.translation.vector, level).map(drop),
+            None => Ok(()),
+        }
     }
 }
 
@@ -162,12 +132,11 @@ impl Task for GoalOrientation {
         Ok(Self::new(s.model.nv(), s.end_effector, s.params.goal_orientation))
     }
 
-    /// Empty without a goal; integrates the error in intentional contact.
+    /// Empty without a goal.
     fn fill(&mut self, cx: &Cycle, level: &mut TaskLevel) -> Result<(), TaskError> {
-        let Some(goal) = cx.goal else { return Ok(()) };
-        self.update(cx.model, cx.data, &goal.rotation, level)?;
-        let pushing = cx.mode == Mode::IntentionalContact;
-        self.integral.integrate(&self.params, &self.error, &goal.rotation.scaled_axis(), cx.dt_s, pushing);
-        Ok(())
+        match cx.goal {
+            Some(goal) => self.update(cx.model, cx.data, &goal.rotation, level).map(drop),
+            None => Ok(()),
+        }
     }
 }

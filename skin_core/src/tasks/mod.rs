@@ -26,7 +26,6 @@ pub mod compliance;
 pub mod contact_reaction;
 mod error;
 pub mod goal;
-pub mod goal_integral;
 pub mod hand_force;
 pub mod params;
 mod point_rows;

@@ -21,10 +21,6 @@ declare_params! {
         pub kv_n_s_per_m: f64 => { unit: "N s/m", range: Range::positive(1e4), live: false },
         /// Speed limit `V_max` of eq. (9) (rad/s for the orientation).
         pub v_max_m_per_s: f64 => { unit: "m/s", range: Range::positive(2.0), live: false },
-        /// Integral time `T_i` of the goal error in intentional contact (`tasks::goal_integral`):
-        /// eq. (7)'s error becomes `e + (1/T_i) ∫ e dt` in Table I (b), so a push against friction
-        /// settles on the goal; the push at rest stays within `k_v V_max`. 0: eq. (7) as printed.
-        pub integral_time_s: f64 => { unit: "s", range: Range::closed(0.0, 1e3), live: false },
     }
 }
 

@@ -13,7 +13,6 @@ use crate::skin::aggregate::PatchWrench;
 use crate::skin::layout::ResolvedLayout;
 use crate::skin::live::LiveCells;
 use crate::skin::params::SkinParams;
-use crate::supervisor::Mode;
 
 /// A commanded base pose and velocity at one instant: the moving `q_d`, `q̇_d` of the base joints
 /// (world x, y \[m\], yaw \[rad\], as the base joints measure them; yaw unwrapped like the joint).
@@ -137,9 +136,6 @@ pub struct Cycle<'a> {
     pub hand: HandSignals,
     /// The end-effector goal, if any.
     pub goal: Option<&'a Isometry3<f64>>,
-    /// The active arrangement (intentional-contact paper Table I, interactive-force-control paper
-    /// Table 1).
-    pub mode: Mode,
     /// The arrangement's proximity sensing range \[m\].
     pub sensing_range_m: f64,
     /// The LIDAR points in the base frame \[m\].

@@ -10,9 +10,8 @@ use super::base_avoidance::BaseAvoidance;
 use super::compliance::BodyCompliance;
 use super::contact_reaction::ContactReaction;
 use super::goal::{saturated_goal_force, GoalOrientation, GoalPosition};
-use super::goal_integral::GoalIntegral;
 use super::hand_force::{HandForce, HandMeasurement};
-use super::params::{GoalParams, HandForceParams, TaskParams};
+use super::params::{HandForceParams, TaskParams};
 use super::position_hold::PositionHold;
 use super::posture::Posture;
 use super::tactile_guidance::TactileGuidance;
@@ -338,68 +337,6 @@ fn hand_force_integral_makes_up_a_lasting_offset_within_its_share() {
     task.integrate(5.9, 0.8);
     task.on_switch(&s.data);
     assert_relative_eq!(p(&task), proportional, epsilon = 1e-12);
-}
-
-/// Eq. (8) on a hand pushing an obstacle along x against Coulomb friction `f_s` (one mass, the
-/// hand and the obstacle together), from rest `e0` short of the goal, for `t_s` of 2 ms cycles:
-/// the final error and the largest push. `pushing`: Table I (b) (the integral grows).
-fn push_against_friction(p: &GoalParams, f_s: f64, e0: f64, t_s: f64, pushing: bool) -> (f64, f64) {
-    let (mass, dt) = (3.0, 0.002);
-    let goal = Vector3::new(e0, 0.0, 0.0);
-    let (mut x, mut v, mut peak) = (0.0_f64, 0.0_f64, 0.0_f64);
-    let mut integral = GoalIntegral::default();
-    for _ in 0..(t_s / dt) as usize {
-        let e = Vector3::new(goal.x - x, 0.0, 0.0);
-        let f = saturated_goal_force(p, &integral.error(p, &e), &Vector3::new(v, 0.0, 0.0)).x;
-        integral.integrate(p, &e, &goal, dt, pushing);
-        peak = peak.max(f.abs());
-        // at rest the obstacle holds below f_s; sliding, friction f_s opposes the motion
-        let net = if v != 0.0 {
-            f - f_s * v.signum()
-        } else if f.abs() > f_s {
-            f - f_s * f.signum()
-        } else {
-            0.0
-        };
-        let v_new = v + net / mass * dt;
-        v = if v != 0.0 && v_new * v <= 0.0 { 0.0 } else { v_new };
-        x += v * dt;
-    }
-    ((goal.x - x).abs(), peak)
-}
-
-/// Intentional contact (Table I (b)): eq. (8) alone stalls where `k_p e = f_s`, short of the goal
-/// by more than the supervisor's 1 cm; with the error's integral the push rises until the obstacle
-/// slides and it settles on the goal, the push never above eq. (9)'s `k_v V_max`. Outside (b),
-/// or with `T_i` = 0, eq. (8) as printed.
-#[test]
-fn goal_integral_pushes_against_friction_onto_the_goal_within_the_saturated_push() {
-    let p = TaskParams::load(&root().join("config/tasks.yaml")).unwrap().goal;
-    assert!(p.integral_time_s > 0.0);
-    let saturated = p.kv_n_s_per_m * p.v_max_m_per_s;
-    let f_s = 0.95 * saturated; // an obstacle that slides just under the saturated push
-    let stall = f_s / p.kp_n_per_m;
-    assert!(stall > 0.01, "eq. (8) alone stalls {stall} m short");
-    let (e, peak) = push_against_friction(&p, f_s, 0.05, 10.0, false);
-    assert!(e > 0.01 && peak <= saturated + 1e-9, "without the integral: {e} m, {peak} N");
-    let (e, peak) = push_against_friction(&p, f_s, 0.05, 10.0, true);
-    assert!(e < 0.002, "with the integral: {e} m short");
-    assert!(peak <= saturated + 1e-9, "push {peak} N above k_v V_max = {saturated} N");
-    let printed = GoalParams { integral_time_s: 0.0, ..p };
-    let (e, _) = push_against_friction(&printed, f_s, 0.05, 10.0, true);
-    assert!(e > 0.01, "T_i = 0: {e} m");
-
-    // zero outside (b) and on a new goal
-    let mut integral = GoalIntegral::default();
-    let (goal, e) = (Vector3::new(0.1, 0.0, 0.0), Vector3::new(0.01, 0.0, 0.0));
-    for _ in 0..100 {
-        integral.integrate(&p, &e, &goal, 0.01, true);
-    }
-    assert!(integral.error(&p, &e).x > e.x);
-    integral.integrate(&p, &e, &(goal * 2.0), 0.01, true);
-    assert_relative_eq!(integral.error(&p, &e).x, e.x * (1.0 + 0.01 / p.integral_time_s), epsilon = 1e-12);
-    integral.integrate(&p, &e, &goal, 0.01, false);
-    assert_eq!(integral.error(&p, &e), e);
 }
 
 #[test]

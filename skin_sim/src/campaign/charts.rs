@@ -9,6 +9,7 @@
 use std::path::Path;
 
 use anyhow::anyhow;
+use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
@@ -26,7 +27,7 @@ fn err(e: impl std::fmt::Display) -> anyhow::Error {
 enum Mark {
     Passed,
     Failed,
-    /// A goal scene that gave up an infeasible push and held.
+    /// A goal scene that gave up an infeasible push and held (a feasible one that did failed).
     Blocked,
     /// Any safety violation, whatever else.
     Unsafe,
@@ -38,9 +39,9 @@ impl Mark {
     fn of(r: &SceneResult, passed: bool) -> Self {
         match &r.verdict {
             Some(v) if !v.violations.is_empty() => Mark::Unsafe,
+            _ if !passed => Mark::Failed,
             Some(v) if v.outcome == Some("blocked") => Mark::Blocked,
-            _ if passed => Mark::Passed,
-            _ => Mark::Failed,
+            _ => Mark::Passed,
         }
     }
 
@@ -90,6 +91,7 @@ struct Scatter<'a> {
     points: Points,
 }
 
+/// One panel in `area`: points off the chart at its edge.
 fn scatter<DB: DrawingBackend>(area: &DrawingArea<DB, plotters::coord::Shift>, s: &Scatter) -> anyhow::Result<()> {
     // off the chart (or never measured: NaN) at its edge
     let y = |v: f64| if v.is_nan() { s.y.end } else { v.clamp(s.y.start, s.y.end) };
@@ -98,36 +100,34 @@ fn scatter<DB: DrawingBackend>(area: &DrawingArea<DB, plotters::coord::Shift>, s
     let mut builder = ChartBuilder::on(area);
     builder.caption(s.title, (FONT, 16)).margin(12).x_label_area_size(40).y_label_area_size(58);
     if s.log_y {
-        let mut chart = builder.build_cartesian_2d(s.x.clone(), (s.y.clone()).log_scale()).map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc(s.x_label)
-            .y_desc(s.y_label)
-            .label_style((FONT, 11))
-            .axis_desc_style((FONT, 12))
-            .y_label_formatter(&|v| format!("{v}"))
-            .draw()
-            .map_err(err)?;
-        draw_points(&mut chart, s, &points)
+        draw(builder.build_cartesian_2d(s.x.clone(), (s.y.clone()).log_scale()).map_err(err)?, s, &points)
     } else {
-        let mut chart = builder.build_cartesian_2d(s.x.clone(), s.y.clone()).map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc(s.x_label)
-            .y_desc(s.y_label)
-            .label_style((FONT, 11))
-            .axis_desc_style((FONT, 12))
-            .draw()
-            .map_err(err)?;
-        draw_points(&mut chart, s, &points)
+        draw(builder.build_cartesian_2d(s.x.clone(), s.y.clone()).map_err(err)?, s, &points)
     }
 }
 
-fn draw_points<'a, DB: DrawingBackend + 'a, Y: Ranged<ValueType = f64>>(
-    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, Y>>,
+/// A tick value without trailing zeros (0.01, 0.5, 100).
+fn tick(v: &f64) -> String {
+    let s = format!("{v:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// The axes, the limits and the points of `s` on `chart`.
+fn draw<'a, DB: DrawingBackend + 'a, Y: Ranged<ValueType = f64> + ValueFormatter<f64>>(
+    mut chart: ChartContext<'a, DB, Cartesian2d<RangedCoordf64, Y>>,
     s: &Scatter,
     points: &Points,
 ) -> anyhow::Result<()> {
+    chart
+        .configure_mesh()
+        .x_desc(s.x_label)
+        .y_desc(s.y_label)
+        .label_style((FONT, 11))
+        .axis_desc_style((FONT, 12))
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .draw()
+        .map_err(err)?;
     let grey = RGBColor(60, 60, 60);
     if let Some((x, name)) = s.x_limit {
         chart
@@ -157,7 +157,7 @@ fn draw_points<'a, DB: DrawingBackend + 'a, Y: Ranged<ValueType = f64>>(
             .label(format!("{} ({n})", mark.label()))
             .legend(move |(a, b)| Circle::new((a + 7, b), 4, style));
     }
-    legend(chart, SeriesLabelPosition::UpperLeft).map_err(err)
+    legend(&mut chart, SeriesLabelPosition::UpperLeft).map_err(err)
 }
 
 /// Draws `panels` side by side into a PNG of `size` at `path`.

@@ -203,6 +203,15 @@ pub fn failures(r: &SceneResult) -> Vec<String> {
     out
 }
 
+/// The class of a failure line: its text before any `:` and without a trailing value
+/// ("first-contact overshoot 2.31 N" → "first-contact overshoot").
+fn failure_class(line: &str) -> String {
+    let head = line.split(':').next().unwrap_or(line);
+    let words: Vec<&str> = head.split_whitespace().collect();
+    let value_at = words.iter().rposition(|w| w.parse::<f64>().is_ok()).filter(|&k| k + 2 >= words.len());
+    words[..value_at.unwrap_or(words.len())].join(" ")
+}
+
 /// `docs/robustness.md`: the summary, the failure classes per family, the figures (in
 /// `figures`, relative to the page) and every failing scene with the command that reruns it.
 pub fn robustness_md(results: &[SceneResult], s: &Summary, figures: &str) -> String {
@@ -242,11 +251,7 @@ pub fn robustness_md(results: &[SceneResult], s: &Summary, figures: &str) -> Str
     for f in FAMILIES {
         let rows: Vec<&SceneResult> = results.iter().filter(|r| r.family == f.name).collect();
         let failing: Vec<Vec<String>> = rows.iter().map(|r| failures(r)).filter(|x| !x.is_empty()).collect();
-        let mut classes: Vec<String> = failing
-            .iter()
-            .flatten()
-            .map(|x| x.split(|c: char| c == ':' || c.is_ascii_digit()).next().unwrap_or(x).trim().to_string())
-            .collect();
+        let mut classes: Vec<String> = failing.iter().flatten().map(|x| failure_class(x)).collect();
         classes.sort();
         classes.dedup();
         md += &format!("| {} | {} | {} | {} |\n", f.name, rows.len(), failing.len(), classes.join(", "));

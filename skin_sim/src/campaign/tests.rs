@@ -71,3 +71,11 @@ fn on_a_tilted_board_the_hand_holds_the_reference_in_newtons_without_impact() {
         assert!((mean - 5.0).abs() < 0.2, "tilt {tilt_deg:?}: {mean} N over the last 5 s for 5 N");
     }
 }
+
+#[test]
+fn failure_classes_drop_details_and_values_only() {
+    assert_eq!(failure_class("Table 3 force error exceeded"), "Table 3 force error exceeded");
+    assert_eq!(failure_class("first-contact overshoot 2.31 N"), "first-contact overshoot");
+    assert_eq!(failure_class("safety: chatter: one switch 3 times"), "safety");
+    assert_eq!(failure_class("goal not reached (feasible)"), "goal not reached (feasible)");
+}

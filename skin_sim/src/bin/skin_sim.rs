@@ -79,8 +79,8 @@ enum Command {
         doc: PathBuf,
     },
     /// Run the randomized scene campaign: scenes varied from a seed, judged for safety and
-    /// success; writes results.json, summary.json and docs/robustness.md. Exit code 1 when a
-    /// scene has a safety violation.
+    /// success; writes results.json and summary.json, and with --doc the page and its figures
+    /// (`make campaign`: docs/robustness.md). Exit code 1 when a scene has a safety violation.
     Campaign(CampaignArgs),
 }
 
@@ -105,9 +105,11 @@ struct CampaignArgs {
     /// Output directory: results.json, summary.json.
     #[arg(long, default_value = "out/campaign")]
     out: PathBuf,
-    /// The generated document.
-    #[arg(long, default_value = "docs/robustness.md")]
-    doc: PathBuf,
+    /// Also write this page, its figures in a folder of the same name beside it (`make campaign`:
+    /// docs/robustness.md); none by default, so a family's or a seed's run leaves the committed
+    /// page alone.
+    #[arg(long)]
+    doc: Option<PathBuf>,
     /// No progress lines on stderr.
     #[arg(long)]
     quiet: bool,
@@ -307,7 +309,7 @@ fn campaign(args: CampaignArgs) -> anyhow::Result<bool> {
             eprintln!("[{done}/{total}] scene {} ({}) {:.1} s: {status}", r.id, r.family, r.wall_s);
         }
     });
-    let files = campaign::write(&args.out, Some(&args.doc), &results, &summary)?;
+    let files = campaign::write(&args.out, args.doc.as_deref(), &results, &summary)?;
     println!("{}", serde_json::to_string_pretty(&summary)?);
     for f in files {
         println!("wrote {}", f.display());

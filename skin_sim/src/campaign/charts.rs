@@ -8,7 +8,6 @@
 
 use std::path::Path;
 
-use anyhow::anyhow;
 use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
@@ -16,11 +15,7 @@ use plotters::prelude::*;
 use super::families::EPS_C_N;
 use super::result::SceneResult;
 use crate::outputs::outcome::FIRST_CONTACT_OVERSHOOT_N;
-use crate::outputs::plot::{font, legend, FONT, PALETTE};
-
-fn err(e: impl std::fmt::Display) -> anyhow::Error {
-    anyhow!("{e}")
-}
+use crate::outputs::plot::{chart_error, font, legend, FONT, PALETTE};
 
 /// How a scene ended, as its marker.
 #[derive(Clone, Copy, PartialEq)]
@@ -100,9 +95,9 @@ fn scatter<DB: DrawingBackend>(area: &DrawingArea<DB, plotters::coord::Shift>, s
     let mut builder = ChartBuilder::on(area);
     builder.caption(s.title, (FONT, 16)).margin(12).x_label_area_size(40).y_label_area_size(58);
     if s.log_y {
-        draw(builder.build_cartesian_2d(s.x.clone(), (s.y.clone()).log_scale()).map_err(err)?, s, &points)
+        draw(builder.build_cartesian_2d(s.x.clone(), (s.y.clone()).log_scale()).map_err(chart_error)?, s, &points)
     } else {
-        draw(builder.build_cartesian_2d(s.x.clone(), s.y.clone()).map_err(err)?, s, &points)
+        draw(builder.build_cartesian_2d(s.x.clone(), s.y.clone()).map_err(chart_error)?, s, &points)
     }
 }
 
@@ -127,19 +122,19 @@ fn draw<'a, DB: DrawingBackend + 'a, Y: Ranged<ValueType = f64> + ValueFormatter
         .x_label_formatter(&tick)
         .y_label_formatter(&tick)
         .draw()
-        .map_err(err)?;
+        .map_err(chart_error)?;
     let grey = RGBColor(60, 60, 60);
     if let Some((x, name)) = s.x_limit {
         chart
             .draw_series(DashedLineSeries::new([(x, s.y.start), (x, s.y.end)], 6, 4, grey.stroke_width(1)))
-            .map_err(err)?
+            .map_err(chart_error)?
             .label(name)
             .legend(move |(a, b)| PathElement::new([(a, b), (a + 14, b)], grey));
     }
     if let Some((y, name)) = s.y_limit {
         chart
             .draw_series(DashedLineSeries::new([(s.x.start, y), (s.x.end, y)], 6, 4, grey.mix(0.6).stroke_width(2)))
-            .map_err(err)?
+            .map_err(chart_error)?
             .label(name)
             .legend(move |(a, b)| PathElement::new([(a, b), (a + 14, b)], grey.mix(0.6).stroke_width(2)));
     }
@@ -153,23 +148,23 @@ fn draw<'a, DB: DrawingBackend + 'a, Y: Ranged<ValueType = f64> + ValueFormatter
         }
         chart
             .draw_series(these)
-            .map_err(err)?
+            .map_err(chart_error)?
             .label(format!("{} ({n})", mark.label()))
             .legend(move |(a, b)| Circle::new((a + 7, b), 4, style));
     }
-    legend(&mut chart, SeriesLabelPosition::UpperLeft).map_err(err)
+    legend(&mut chart, SeriesLabelPosition::UpperLeft).map_err(chart_error)
 }
 
 /// Draws `panels` side by side into a PNG of `size` at `path`.
 fn panels(path: &Path, title: &str, size: (u32, u32), panels: &[Scatter]) -> anyhow::Result<()> {
-    font().map_err(err)?;
+    font().map_err(chart_error)?;
     let root = BitMapBackend::new(path, size).into_drawing_area();
-    root.fill(&WHITE).map_err(err)?;
-    let root = root.titled(title, (FONT, 19)).map_err(err)?;
+    root.fill(&WHITE).map_err(chart_error)?;
+    let root = root.titled(title, (FONT, 19)).map_err(chart_error)?;
     for (area, s) in root.split_evenly((1, panels.len())).iter().zip(panels) {
         scatter(area, s)?;
     }
-    root.present().map_err(err)
+    root.present().map_err(chart_error)
 }
 
 /// Past the largest finite friction: where fixed obstacles are drawn \[N\].

@@ -3,17 +3,12 @@
 
 use std::path::Path;
 
-use anyhow::anyhow;
 use plotters::prelude::*;
 
 use super::analysis::{self, Candidate};
 use super::grid::Axis;
 use super::variant::PointResult;
-use crate::outputs::plot::{font, legend, FONT, PALETTE};
-
-fn err(e: impl std::fmt::Display) -> anyhow::Error {
-    anyhow!("{e}")
-}
+use crate::outputs::plot::{chart_error, font, legend, FONT, PALETTE};
 
 /// Colour of the points that vary `axis`.
 fn axis_colour(axis: Axis) -> RGBColor {
@@ -49,7 +44,7 @@ fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 /// crosses for unstable points, the baseline ringed, the Pareto front of the stable points joined
 /// and labelled.
 pub fn pareto(points: &[&PointResult], path: &Path) -> anyhow::Result<()> {
-    font().map_err(err)?;
+    font().map_err(chart_error)?;
     let scenario = points.first().map_or("", |p| p.point.scenario.as_str());
     let plotted: Vec<(&PointResult, f64, f64)> = points
         .iter()
@@ -57,7 +52,7 @@ pub fn pareto(points: &[&PointResult], path: &Path) -> anyhow::Result<()> {
         .filter(|(_, x, y)| *x > 0.0 && *y > 0.0)
         .collect();
     let root = BitMapBackend::new(path, (1000, 650)).into_drawing_area();
-    root.fill(&WHITE).map_err(err)?;
+    root.fill(&WHITE).map_err(chart_error)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(format!("{scenario}: accuracy against cost"), (FONT, 20))
         .margin(16)
@@ -67,7 +62,7 @@ pub fn pareto(points: &[&PointResult], path: &Path) -> anyhow::Result<()> {
             log_range(plotted.iter().map(|p| p.1)).log_scale(),
             log_range(plotted.iter().map(|p| p.2)).log_scale(),
         )
-        .map_err(err)?;
+        .map_err(chart_error)?;
     chart
         .configure_mesh()
         .x_desc("CPU time per simulated second [s/s] (log)")
@@ -79,7 +74,7 @@ pub fn pareto(points: &[&PointResult], path: &Path) -> anyhow::Result<()> {
         .x_label_formatter(&|v| format!("{v:.3}"))
         .y_label_formatter(&|v| format!("{v:.3}"))
         .draw()
-        .map_err(err)?;
+        .map_err(chart_error)?;
     for axis in [Axis::RateTimestep, Axis::Density, Axis::Inverse, Axis::All] {
         let colour = axis_colour(axis);
         let of_axis: Vec<_> = plotted.iter().filter(|p| p.0.point.axis == axis).collect();
@@ -89,26 +84,26 @@ pub fn pareto(points: &[&PointResult], path: &Path) -> anyhow::Result<()> {
         let stable = |p: &&&(&PointResult, f64, f64)| p.0.figures().is_some_and(|f| f.unstable.is_none());
         chart
             .draw_series(of_axis.iter().filter(stable).map(|p| Circle::new((p.1, p.2), 5, colour.filled())))
-            .map_err(err)?
+            .map_err(chart_error)?
             .label(axis.name())
             .legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled()));
         chart
             .draw_series(
                 of_axis.iter().filter(|p| !stable(p)).map(|p| Cross::new((p.1, p.2), 6, colour.stroke_width(2))),
             )
-            .map_err(err)?;
+            .map_err(chart_error)?;
     }
     chart
         .draw_series(
             plotted.iter().filter(|p| p.0.point.baseline).map(|p| Circle::new((p.1, p.2), 9, BLACK.stroke_width(1))),
         )
-        .map_err(err)?
+        .map_err(chart_error)?
         .label("scenario's own setting (ringed); x: unstable")
         .legend(|(x, y)| Circle::new((x + 10, y), 7, BLACK.stroke_width(1)));
     let front: Vec<Candidate> = analysis::pareto(&analysis::candidates(points));
     chart
         .draw_series(LineSeries::new(front.iter().map(|c| (c.cost, c.error)), BLACK.mix(0.5).stroke_width(1)))
-        .map_err(err)?
+        .map_err(chart_error)?
         .label("Pareto front (stable points)")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.mix(0.5)));
     chart
@@ -117,9 +112,9 @@ pub fn pareto(points: &[&PointResult], path: &Path) -> anyhow::Result<()> {
             let text = format!("{} Hz/{} ms/{}", s.control_rate_hz, s.timestep_s * 1e3, s.density.name());
             Text::new(text, (c.cost, c.error), (FONT, 11).into_font().color(&BLACK.mix(0.8)))
         }))
-        .map_err(err)?;
-    legend(&mut chart, SeriesLabelPosition::UpperRight).map_err(err)?;
-    root.present().map_err(err)
+        .map_err(chart_error)?;
+    legend(&mut chart, SeriesLabelPosition::UpperRight).map_err(chart_error)?;
+    root.present().map_err(chart_error)
 }
 
 /// Height of one row of the stability chart \[px\].
@@ -128,7 +123,7 @@ const ROW: u32 = 17;
 /// `stability.png`: per scenario, one bar per point that ran, green up to the end of the run when
 /// it stayed stable, red up to the time it went unstable.
 pub fn stability(points: &[PointResult], path: &Path) -> anyhow::Result<()> {
-    font().map_err(err)?;
+    font().map_err(chart_error)?;
     let scenarios = analysis::scenarios(points);
     let ran: Vec<Vec<&PointResult>> = scenarios
         .iter()
@@ -136,7 +131,7 @@ pub fn stability(points: &[PointResult], path: &Path) -> anyhow::Result<()> {
         .collect();
     let heights: Vec<u32> = ran.iter().map(|r| 70 + ROW * r.len() as u32).collect();
     let root = BitMapBackend::new(path, (1000, heights.iter().sum::<u32>().max(100))).into_drawing_area();
-    root.fill(&WHITE).map_err(err)?;
+    root.fill(&WHITE).map_err(chart_error)?;
     let mut rest = root.clone();
     for ((scenario, rows), h) in scenarios.iter().zip(&ran).zip(&heights) {
         let (area, below) = rest.split_vertically(*h);
@@ -149,7 +144,7 @@ pub fn stability(points: &[PointResult], path: &Path) -> anyhow::Result<()> {
             .x_label_area_size(30)
             .y_label_area_size(330)
             .build_cartesian_2d(0.0..end.max(1e-3), -0.5..rows.len() as f64 - 0.5)
-            .map_err(err)?;
+            .map_err(chart_error)?;
         let label = |v: &f64| {
             labels.get(v.round() as usize).filter(|_| (v - v.round()).abs() < 1e-6).cloned().unwrap_or_default()
         };
@@ -162,7 +157,7 @@ pub fn stability(points: &[PointResult], path: &Path) -> anyhow::Result<()> {
             .y_labels(rows.len().max(1))
             .y_label_formatter(&label)
             .draw()
-            .map_err(err)?;
+            .map_err(chart_error)?;
         chart
             .draw_series(rows.iter().enumerate().map(|(k, p)| {
                 let f = p.figures().expect("filtered on figures");
@@ -173,7 +168,7 @@ pub fn stability(points: &[PointResult], path: &Path) -> anyhow::Result<()> {
                 let y = k as f64;
                 Rectangle::new([(0.0, y - 0.35), (t.max(end * 0.003), y + 0.35)], colour.mix(0.8).filled())
             }))
-            .map_err(err)?;
+            .map_err(chart_error)?;
     }
-    root.present().map_err(err)
+    root.present().map_err(chart_error)
 }

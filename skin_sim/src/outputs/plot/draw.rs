@@ -67,6 +67,12 @@ fn err(e: impl std::fmt::Display) -> String {
     e.to_string()
 }
 
+/// A plotters error as the `anyhow::Error` the charts of the study, the benchmarks and the
+/// campaign return.
+pub(crate) fn chart_error(e: impl std::fmt::Display) -> anyhow::Error {
+    anyhow::anyhow!("{e}")
+}
+
 /// Register the shipped font once per process.
 pub(crate) fn font() -> Result<(), String> {
     static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();

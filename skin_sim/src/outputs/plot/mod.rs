@@ -20,8 +20,8 @@ mod draw;
 mod figure;
 mod layouts;
 
-// The study's charts (`crate::study::charts`) draw with the same font and colours.
-pub(crate) use draw::{font, legend, FONT, PALETTE};
+// The charts of the study, the benchmarks and the campaign draw with the same font, colours and errors.
+pub(crate) use draw::{chart_error, font, legend, FONT, PALETTE};
 pub use figure::{intervals_where, Figure, Panel, PlotError, Tint};
 pub use layouts::{
     force_tracking_figure, guidance_figure, intentional_contact_figure, ForceTrackingSignals, GuidanceSignals,

@@ -6,7 +6,7 @@
 //! limit, contact over eps_c for more than 0.5 s in one event, chatter) and end `reached` or
 //! `blocked`; the fixed obstacle must end `blocked` after a single (b) -> (c).
 
-use skin_core::supervisor::Mode;
+use skin_core::supervisor::{Mode, SupervisorParams};
 use skin_sim::outputs::outcome;
 use skin_sim::outputs::report::RunReport;
 use skin_sim::outputs::safety;
@@ -58,9 +58,12 @@ fn a_fixed_obstacle_is_pushed_at_most_twice_then_the_arm_holds_blocked() {
     assert!((1..=2).contains(&n), "at most two pushes, no (b) <-> (c) cycle: {:?}", r.record.switches);
     let last = r.record.cycles.last().unwrap();
     assert_eq!(last.mode, Mode::Avoidance, "held in (a)");
-    // Settled: once held (and the blend and back-off of the first second are over), the arm
-    // touches nothing over eps_c and stands still.
-    let held = r.metrics.goal.as_ref().unwrap().blocked_at_s + 1.0;
+    // Settled: once held and backed off (avoidance's sensing range restored from the push's 0 to
+    // nominal, plus the 0.5 s of the switch's blend), the arm touches nothing over eps_c and
+    // stands still.
+    let sup = SupervisorParams::load(&skin_sim::scene::config_dir().join("supervisor.yaml")).unwrap();
+    let back_off = sup.sensing_range.nominal_m / sup.sensing_range.restore_rate_mps + 0.5;
+    let held = r.metrics.goal.as_ref().unwrap().blocked_at_s + back_off;
     let after: Vec<_> = r.record.cycles.iter().filter(|c| c.t_s >= held).collect();
     assert!(after.len() > 1000, "held for {} cycles", after.len());
     let eps_c = r.metrics.goal.as_ref().unwrap().eps_c_n;
@@ -132,9 +135,9 @@ fn setup_without_contact_reaction(dir: &std::path::Path) -> std::path::PathBuf {
 }
 
 /// Done-when of issue 17: removing contact reaction (intentional-contact paper eq. (6)) from
-/// the arrangements makes a check fail. The shipped fixed-obstacle scene declares its peak
-/// contact force (3 eps_c): the contact reaction, first in Table I (c), cuts the failed push's
-/// hard contact short; without it the goal keeps pushing into the fixed obstacle.
+/// the arrangements makes a check fail. In the shipped fixed-obstacle scene the contact
+/// reaction, first in Table I (c), relieves the failed push's hard contact so that the arm ends
+/// `blocked`; without it the goal keeps the arm pressed on the fixed obstacle in (c).
 #[test]
 fn removing_contact_reaction_fails_the_fixed_obstacle_scene() {
     let scene = skin_sim::scene::config_dir().join("scenes/intentional_contact_fixed_obstacle.yaml");
@@ -152,7 +155,9 @@ fn removing_contact_reaction_fails_the_fixed_obstacle_scene() {
     let report = without.run(&Default::default(), |_| {}).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
     let failed: Vec<&str> = report.checks.iter().filter(|c| !c.passed).map(|c| c.name).collect();
-    // (Without the reaction the arm keeps pressing, so (c) is not left for the blocked hold
-    // either: the outcome check may fail too.)
-    assert!(failed.contains(&"peak contact force (outside pushes)"), "{:?}", report.checks);
+    // Without the reaction nothing relieves the hard contact: (c) is never left for the blocked
+    // hold (the outcome check fails), and without the skin's approach bound (docs/resolver.md)
+    // the goal also presses the obstacle over the declared peak force.
+    assert!(failed.contains(&"goal reached or blocked (the goal may be unreachable)"), "{:?}", report.checks);
+    assert_eq!(outcome(&report), "not_reached");
 }

@@ -2,6 +2,7 @@
 
 use nalgebra::{DMatrix, DVector, Isometry3};
 
+use super::approach::ApproachBound;
 use super::io::{ControllerInput, ControllerOutput, Fault};
 use super::setup::{ControllerConfig, HierarchyDynamics, SetupError};
 use super::stages::{Stage, StageClock, StageTimes};
@@ -61,6 +62,8 @@ pub struct Controller {
     /// The commanded base motion, if any.
     base_reference: Option<BaseReference>,
     solver: HierarchySolver,
+    /// The skin's approach bound on the command (`docs/resolver.md`).
+    approach: ApproachBound,
     resolver: Resolver,
     supervisor: Supervisor,
     blender: TorqueBlender,
@@ -142,8 +145,11 @@ impl Controller {
         solver
             .set_locked_joints(&locked)
             .map_err(|error| SetupError::Inverse { file: config.source.clone(), error })?;
-        let resolver = Resolver::with_held(model, config.resolver.clone(), &locked)
+        let mut resolver = Resolver::with_held(model, config.resolver.clone(), &locked)
             .map_err(|error| SetupError::Resolver { file: config.setup.resolver.display().to_string(), error })?;
+        let eps_c = config.supervisor.thresholds.contact_force_n;
+        let approach = ApproachBound::new(config.resolver.approach, eps_c, config.skin.force.prepared(), nv);
+        *resolver.closing_bounds_mut() = approach.limits(nv, config.layout.num_cells());
         let supervisor = Supervisor::new(&config.supervisor, t0_s)?;
         let output = ControllerOutput {
             commands: resolver.commands().clone(),
@@ -159,6 +165,7 @@ impl Controller {
         Ok(Controller {
             data: ModelData::new(model),
             solver,
+            approach,
             resolver,
             blender: TorqueBlender::new(nv),
             ee,
@@ -483,7 +490,12 @@ impl Controller {
         self.output.torque_norm = self.tau.norm();
         self.clock.lap(Stage::Hierarchy);
 
-        // 5. admittance resolver
+        // 5. admittance resolver, within the skin's approach bound
+        let (live, releasing) = (&self.live, self.supervisor.releasing());
+        let bounds = self.resolver.closing_bounds_mut();
+        self.approach
+            .update(model, &self.data, layout, live, &self.fusion, releasing, bounds)
+            .map_err(stage("approach bound"))?;
         self.resolver
             .update(self.tau.as_slice(), self.gravity.as_slice(), input.q, input.qd, input.dt_s)
             .map_err(stage("resolver"))?;

@@ -4,6 +4,7 @@
 //! [`ControllerConfig::load`]) that names the URDF, the skin layout, the parameter files and the
 //! frames the tasks act on. `docs/controller.md` describes the cycle.
 
+mod approach;
 mod cycle;
 mod hand_force;
 mod io;

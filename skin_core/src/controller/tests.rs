@@ -337,3 +337,61 @@ fn stage_timing_charges_every_stage_without_changing_the_commands() {
     timed.set_stage_timing(false);
     assert!(timed.stage_times().is_none());
 }
+
+/// Largest closing speed `nᵀ v(p)` over the cells, and its excess over the approach bound at
+/// the sensed distance `d` (positive: too fast), at the state `q`, `qd`.
+fn closing_speeds(c: &Controller, q: &[f64], qd: &[f64], d: f64, touch_mps: f64) -> (f64, f64) {
+    let model = &c.config().model;
+    let mut data = crate::model::ModelData::new(model);
+    crate::model::update_kinematics(model, &mut data, q, qd).unwrap();
+    let approach = c.config().resolver.approach;
+    let mut worst = (0.0f64, f64::NEG_INFINITY);
+    for cell in c.config().layout.cells() {
+        let v = crate::model::point_velocity(model, &data, cell.frame, &cell.position_link).unwrap();
+        let closing = (data.frame_pose(cell.frame).rotation * cell.normal_link).dot(&v);
+        worst.0 = worst.0.max(closing);
+        worst.1 = worst.1.max(closing - (touch_mps + d / approach.time_s));
+    }
+    worst
+}
+
+/// Drives planar7 toward a far goal for 2 s while every cell senses a surface 1 cm away (every
+/// direction of motion closes on one): per cycle, the fastest closing speed and the largest
+/// excess over the bound.
+fn drive_among_surfaces(mut c: Controller) -> Vec<(f64, f64)> {
+    let (d, dt) = (0.01, 0.008);
+    let signal = c.config().skin.proximity.signal(d);
+    let cells = vec![CellReading::uniform(0.0, signal); c.config().layout.num_cells()];
+    let mut q = c.config().setup.posture.clone();
+    let mut qd = vec![0.0; 7];
+    c.set_goal(Some(Isometry3::from_parts(Translation3::new(0.9, 0.8, 0.0), UnitQuaternion::identity()))).unwrap();
+    let touch = c.config().resolver.approach.speed_min_mps;
+    (0..250)
+        .map(|k| {
+            let out =
+                c.update(&ControllerInput { t_s: k as f64 * dt, dt_s: dt, q: &q, qd: &qd, cells: &cells, scan: &[] });
+            assert_eq!(out.fault, None);
+            follow(&c, &mut q, &mut qd, dt);
+            closing_speeds(&c, &q, &qd, d, touch)
+        })
+        .collect()
+}
+
+#[test]
+fn no_skin_point_closes_on_a_sensed_surface_faster_than_the_approach_bound() {
+    let max = |v: &[(f64, f64)], f: fn(&(f64, f64)) -> f64| v.iter().map(f).fold(f64::NEG_INFINITY, f64::max);
+    let shipped = ControllerConfig::load(&setup("planar7")).unwrap();
+    let touch = shipped.resolver.approach.speed_min_mps;
+    // the bound itself, without the per-joint acceleration limit that follows it
+    let mut free = shipped.clone();
+    free.resolver.arm.max_acceleration = 1e3;
+    let bounded = drive_among_surfaces(Controller::new(free.clone(), 0.0).unwrap());
+    assert!(max(&bounded, |c| c.0) > 0.5 * touch, "the arm moves toward the surfaces");
+    assert!(max(&bounded, |c| c.1) < 1e-3, "a cell closed {} m/s faster than its bound", max(&bounded, |c| c.1));
+    free.resolver.approach.enabled = false;
+    let unbounded = max(&drive_among_surfaces(Controller::new(free, 0.0).unwrap()), |c| c.1);
+    assert!(unbounded > 0.01, "without the bound the goal closes faster: {unbounded} m/s over");
+    // shipped limits: the per-joint rate limit of the start (docs/resolver.md) is the one exception
+    let runs = drive_among_surfaces(Controller::new(shipped, 0.0).unwrap());
+    assert!(max(&runs[10..], |c| c.1) < 1e-3, "after the start: {} m/s over", max(&runs[10..], |c| c.1));
+}

@@ -1,6 +1,7 @@
 //! The resolver itself: interactive-force-control paper eq. (26) integrated exactly per step, the inner velocity loop,
 //! the limits and the safe stop, for the arms and the base at their own rates.
 
+use super::closing::{bound_closing, ClosingBounds};
 use super::error::ResolverError;
 use super::limits::{clamp_norm, finite_or_max, position_limit, rate_limit, scale_chains};
 use super::params::ResolverParams;
@@ -78,6 +79,10 @@ pub struct Resolver {
     held: Vec<bool>,
     /// Scratch: the virtual velocities before the limits.
     target: Vec<f64>,
+    /// `1 / inertia` of each arm joint, 0 for a held one (the metric of the closing bounds).
+    inverse_inertia: Vec<f64>,
+    /// The closing-speed limits the arm steps meet ([`Resolver::closing_bounds_mut`]).
+    closing: ClosingBounds,
     /// Cached exact-step coefficients for `arm_dt`.
     arm_steps: Vec<Step>,
     arm_dt: f64,
@@ -137,6 +142,8 @@ impl Resolver {
             vmax: vec![0.0; na],
             held: arm_indices.iter().map(|&j| held.get(j).copied().unwrap_or(false)).collect(),
             target: vec![0.0; na],
+            inverse_inertia: vec![0.0; na],
+            closing: ClosingBounds::default(),
             arm_dt: f64::NAN,
             base,
             base_steps: [Step::default(); 3],
@@ -182,6 +189,9 @@ impl Resolver {
             a.lower = lim.lower;
             a.upper = lim.upper;
         }
+        for ((w, a), &held) in self.inverse_inertia.iter_mut().zip(&joints).zip(&self.held) {
+            *w = if held { 0.0 } else { 1.0 / a.inertia };
+        }
         self.arm = joints;
         self.vmax = vmax;
         self.params = params;
@@ -213,6 +223,13 @@ impl Resolver {
     /// Acceleration limit of each arm joint \[rad/s²\].
     pub fn arm_acceleration_limits(&self) -> impl Iterator<Item = f64> + '_ {
         self.arm.iter().map(|a| a.amax)
+    }
+
+    /// The closing-speed limits `r·q̇ ≤ b` (model joint order) that the arm steps meet before
+    /// the other limits, the base moving at its measured velocity: the skin's approach bound,
+    /// refreshed by the controller every cycle (`docs/resolver.md`); none by default.
+    pub fn closing_bounds_mut(&mut self) -> &mut ClosingBounds {
+        &mut self.closing
     }
 
     /// The commands of the last step.
@@ -277,6 +294,7 @@ impl Resolver {
             // a held joint's target is 0, so it does not scale its chain down (its limit is 0)
             target[i] = if self.held[i] { 0.0 } else { finite_or_max(s.e * v + s.phi * f) };
         }
+        bound_closing(target, &self.arm_indices, &self.inverse_inertia, qd_measured, &self.closing);
         scale_chains(target, &self.vmax, &self.chain, &mut self.chain_scale);
         for (i, a) in self.arm.iter().enumerate() {
             let vmax = self.vmax[i];

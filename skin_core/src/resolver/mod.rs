@@ -12,6 +12,7 @@
 //! [`Resolver::update_arms`] / [`Resolver::update_base`] (no allocation after `new`).
 
 mod admittance;
+mod closing;
 mod error;
 mod limits;
 mod params;
@@ -21,5 +22,6 @@ mod tests;
 
 /// The base joint names live with the model; re-exported where the resolver splits arm and base.
 pub use admittance::{Commands, Resolver};
+pub use closing::ClosingBounds;
 pub use error::ResolverError;
-pub use params::{ArmParams, BaseParams, JointOverride, ResolverParams};
+pub use params::{ApproachParams, ArmParams, BaseParams, JointOverride, ResolverParams};

@@ -20,6 +20,33 @@ declare_params! {
         pub arm: ArmParams => nested,
         /// Holonomic base: `M_b ẍ_b + D_b ẋ_b = τ_b*` (interactive-force-control paper eq. (26), lower row).
         pub base: BaseParams => nested,
+        /// The skin's approach bound on the arm command (`docs/resolver.md`).
+        #[serde(default)]
+        pub approach: ApproachParams => nested,
+    }
+}
+
+declare_params! {
+    /// No skin point closes on a surface its cell senses faster than `speed_min_mps + d / time_s`
+    /// (`d` the cell's proximity distance): the body slows down as a surface comes near and
+    /// touches it, or comes back to it after a contact, at most at `speed_min_mps` (0 for a cell
+    /// pressed at `ε_c` and in a hard contact that ends a push, `docs/resolver.md`).
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields)]
+    pub struct ApproachParams {
+        /// Whether the bound is applied.
+        pub enabled: bool => { choices: "true | false", live: false },
+        /// Closing speed allowed at contact (`d = 0`): also the fastest push into a surface.
+        pub speed_min_mps: f64 => { unit: "m/s", range: Range::positive(10.0), live: false },
+        /// Time in which the allowed closing speed would cover the sensed distance.
+        pub time_s: f64 => { unit: "s", range: Range::positive(100.0), live: false },
+    }
+}
+
+impl Default for ApproachParams {
+    /// The shipped values (`config/resolver.yaml`).
+    fn default() -> Self {
+        Self { enabled: true, speed_min_mps: 0.02, time_s: 0.5 }
     }
 }
 
@@ -138,6 +165,7 @@ impl Default for ResolverParams {
                 max_linear_accel_m_s2: 1.0,
                 max_angular_accel_rad_s2: 2.0,
             },
+            approach: ApproachParams::default(),
         }
     }
 }

@@ -262,6 +262,13 @@ impl Supervisor {
         self.blocked
     }
 
+    /// In a hard contact (c) that no push follows (entered from (a), or from (b) without a
+    /// retry): the contact is to be relieved, not pressed again (the skin's approach bound lets
+    /// nothing close on a sensed surface then, `docs/resolver.md`).
+    pub fn releasing(&self) -> bool {
+        self.arrangement.mode == Mode::HardContact && !(self.resume == Mode::IntentionalContact && self.retry)
+    }
+
     /// The goal changed: a push that was given up may succeed toward the new goal, so the
     /// [`Blocked`] hold ends.
     pub fn new_goal(&mut self) {

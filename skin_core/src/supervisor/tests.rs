@@ -147,8 +147,10 @@ fn a_push_that_made_progress_is_retried_once_per_interval() {
     let min = p.thresholds.progress_min_m;
     let (mut sup, mut t) = in_b(&p);
     run(&mut sup, &mut t, 10, input(0.02, 0.0, 2.0, 0.2));
+    assert!(!sup.releasing(), "(b) is no hard contact");
     let tr = run(&mut sup, &mut t, 1, input(0.02, 0.0, 6.0, 0.2 - 2.0 * min));
     assert_eq!((tr[0].to, tr[0].cause), (Mode::HardContact, Cause::ContactOverLimit));
+    assert!(!sup.releasing(), "a retried push goes on pressing after (c)");
     let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
     assert_eq!(
         (tr[0].from, tr[0].to, tr[0].cause),
@@ -158,6 +160,7 @@ fn a_push_that_made_progress_is_retried_once_per_interval() {
     // Progress again, but 0.8 s after the last hard contact: given up.
     run(&mut sup, &mut t, 10, input(0.02, 0.0, 2.0, 0.2));
     run(&mut sup, &mut t, 1, input(0.02, 0.0, 6.0, 0.2 - 4.0 * min));
+    assert!(sup.releasing(), "a push given up is released, not pressed again");
     let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
     assert_eq!(tr.last().map(|tr| tr.cause), Some(Cause::PushBlocked));
 

@@ -38,7 +38,7 @@ fn stage<E>(name: &'static str) -> impl FnOnce(E) -> Fault {
 ///    `C q̇ + g`);
 /// 4. the torque blended across arrangement switches (intentional-contact paper eq. 10-11);
 /// 5. the admittance resolver (interactive-force-control paper eq. 26) turns it into joint and base velocity commands
-///    within the limits.
+///    within the limits, the skin's approach bound first (`docs/resolver.md`).
 ///
 /// Bad input (wrong lengths, NaN state, bad `dt`) or a failed stage makes the cycle a safe-stop
 /// step instead (`ControllerOutput::fault`), so the commands are always finite and within the

@@ -264,7 +264,8 @@ impl Supervisor {
 
     /// In a hard contact (c) that no push follows (entered from (a), or from (b) without a
     /// retry): the contact is to be relieved, not pressed again (the skin's approach bound lets
-    /// nothing close on a sensed surface then, `docs/resolver.md`).
+    /// nothing close on a sensed surface then, `docs/resolver.md`). A follower
+    /// ([`Self::impose`]) cannot tell a retry from the arrangement it is given: every (c) counts.
     pub fn releasing(&self) -> bool {
         self.arrangement.mode == Mode::HardContact && !(self.resume == Mode::IntentionalContact && self.retry)
     }

@@ -726,11 +726,13 @@ fn follower_reproduces_the_deciding_supervisor() {
                     fusion_weight_target: a.fusion_weight_target,
                 })
                 .unwrap();
-            let f = follower.update(t, &SupervisorInput::default());
+            let f = follower.update(t, &SupervisorInput::default()).clone();
             assert_eq!(f.mode, a.mode, "cycle {k}");
             assert_eq!(f.task_order(), a.task_order());
             assert_eq!(f.switch_time_s.to_bits(), a.switch_time_s.to_bits());
             assert_eq!(f.sensing_range_m, a.sensing_range_m);
+            // the imposed arrangement does not say whether a retry follows: every (c) releases
+            assert_eq!(follower.releasing(), f.mode == Mode::HardContact, "cycle {k}");
             assert!(
                 (f.fusion_weight - a.fusion_weight).abs() < 1e-12,
                 "cycle {k}: w {} vs {}",

@@ -27,9 +27,9 @@ impl ApproachBound {
         Self { params, force_limit_n, force, row: vec![0.0; nv] }
     }
 
-    /// Room for the limits of a layout with `cells` cells on a model with `nv` joints.
-    pub(crate) fn limits(&self, nv: usize, cells: usize) -> ClosingBounds {
-        ClosingBounds::with_capacity(nv, if self.params.enabled { cells } else { 0 })
+    /// Room for the limits of a layout with `cells` cells.
+    pub(crate) fn limits(&self, cells: usize) -> ClosingBounds {
+        ClosingBounds::with_capacity(self.row.len(), if self.params.enabled { cells } else { 0 })
     }
 
     /// Sets `bounds` to the limits for the cells' readings at the state of the last kinematics
@@ -60,8 +60,7 @@ impl ApproachBound {
             if d >= range {
                 continue;
             }
-            let signal = reading.force_signal(fusion.force_reduction);
-            let at_limit = signal > fusion.activity_threshold && self.force.force_n(signal) >= self.force_limit_n;
+            let at_limit = fusion.cell_force_n(reading, &self.force).is_some_and(|f| f >= self.force_limit_n);
             let touch = if releasing || at_limit { 0.0 } else { p.speed_min_mps };
             let cell = &layout.cells()[*i];
             let outward = data.frame_pose(cell.frame).rotation * cell.normal_link;

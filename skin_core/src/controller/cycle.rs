@@ -149,7 +149,7 @@ impl Controller {
             .map_err(|error| SetupError::Resolver { file: config.setup.resolver.display().to_string(), error })?;
         let eps_c = config.supervisor.thresholds.contact_force_n;
         let approach = ApproachBound::new(config.resolver.approach, eps_c, config.skin.force.prepared(), nv);
-        *resolver.closing_bounds_mut() = approach.limits(nv, config.layout.num_cells());
+        *resolver.closing_bounds_mut() = approach.limits(config.layout.num_cells());
         let supervisor = Supervisor::new(&config.supervisor, t0_s)?;
         let output = ControllerOutput {
             commands: resolver.commands().clone(),

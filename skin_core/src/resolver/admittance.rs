@@ -294,7 +294,8 @@ impl Resolver {
             // a held joint's target is 0, so it does not scale its chain down (its limit is 0)
             target[i] = if self.held[i] { 0.0 } else { finite_or_max(s.e * v + s.phi * f) };
         }
-        bound_closing(target, &self.arm_indices, &self.inverse_inertia, qd_measured, &self.closing);
+        let base = self.base.as_ref().map_or(&[][..], |b| &b[..]);
+        bound_closing(target, &self.arm_indices, &self.inverse_inertia, base, qd_measured, &self.closing);
         scale_chains(target, &self.vmax, &self.chain, &mut self.chain_scale);
         for (i, a) in self.arm.iter().enumerate() {
             let vmax = self.vmax[i];

@@ -50,18 +50,24 @@ impl ClosingBounds {
 }
 
 /// Brings the arm velocities `v` (arm order; `index[i]` is arm joint `i`'s model index) within
-/// `bounds`, the other joints moving at `qd_other` (model order; the arm entries are ignored):
+/// `bounds`, the joints `others` (model indices; the base's) moving at their `qd` (model order):
 /// each violated limit is met by the least change of `v` in the metric of the virtual inertia,
 /// `v ← v − W r (r·q̇ − b) / (rᵀ W r)` with `W = diag(w)` (`w_i = 1 / inertia_i`, 0 for a held
 /// joint), the velocity change an impulse along the row would make. Limits only slow a point
 /// down toward its surface; motion away from it is never changed.
-pub(crate) fn bound_closing(v: &mut [f64], index: &[usize], w: &[f64], qd_other: &[f64], bounds: &ClosingBounds) {
+pub(crate) fn bound_closing(
+    v: &mut [f64],
+    index: &[usize],
+    w: &[f64],
+    others: &[usize],
+    qd: &[f64],
+    bounds: &ClosingBounds,
+) {
     for _ in 0..SWEEPS {
         let mut met = true;
         for (row, b) in bounds.iter() {
             let arm: f64 = index.iter().zip(v.iter()).map(|(&j, vi)| row[j] * vi).sum();
-            let all: f64 = row.iter().zip(qd_other).map(|(r, q)| r * q).sum();
-            let other = all - index.iter().map(|&j| row[j] * qd_other[j]).sum::<f64>();
+            let other: f64 = others.iter().map(|&j| row[j] * qd[j]).sum();
             let excess = arm + other - b;
             if excess <= 0.0 {
                 continue;
@@ -92,11 +98,11 @@ mod tests {
         let mut b = ClosingBounds::with_capacity(3, 2);
         b.push(&[1.0, 1.0, 0.0], 0.15);
         let mut v = [0.2, 0.3];
-        bound_closing(&mut v, &[1, 2], &[1.0, 1.0], &[0.1, 9.0, 9.0], &b);
+        bound_closing(&mut v, &[1, 2], &[1.0, 1.0], &[0], &[0.1, 9.0, 9.0], &b);
         assert!((0.1 + v[0] - 0.15).abs() < 1e-12, "{v:?}");
         assert_eq!(v[1], 0.3, "a joint the row does not involve keeps its speed");
         let mut away = [-0.2, 0.3];
-        bound_closing(&mut away, &[1, 2], &[1.0, 1.0], &[0.1, 0.0, 0.0], &b);
+        bound_closing(&mut away, &[1, 2], &[1.0, 1.0], &[0], &[0.1, 0.0, 0.0], &b);
         assert_eq!(away, [-0.2, 0.3], "moving away is never limited");
     }
 
@@ -106,12 +112,12 @@ mod tests {
         b.push(&[0.0, 1.0, 1.0], 0.1);
         b.push(&[0.0, 1.0, 0.5], 0.1);
         let mut v = [1.0, 1.0, 1.0];
-        bound_closing(&mut v[..2], &[1, 2], &[1.0, 2.0], &[0.0; 3], &b);
+        bound_closing(&mut v[..2], &[1, 2], &[1.0, 2.0], &[0], &[0.0; 3], &b);
         for (row, bound) in b.iter() {
             assert!(row[1] * v[0] + row[2] * v[1] <= bound + 1e-3, "{v:?}");
         }
         let mut held = [1.0, 1.0];
-        bound_closing(&mut held, &[1, 2], &[0.0, 1.0], &[0.0; 3], &b);
+        bound_closing(&mut held, &[1, 2], &[0.0, 1.0], &[0], &[0.0; 3], &b);
         assert_eq!(held[0], 1.0, "a held joint (w = 0) is not moved by the bound");
     }
 }

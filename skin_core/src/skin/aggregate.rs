@@ -10,6 +10,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use super::characteristic::PreparedForce;
 use super::layout::ResolvedLayout;
 use super::live::LiveCells;
 use super::signals::{CellReading, ForceReduction};
@@ -60,6 +61,15 @@ declare_params! {
 }
 
 impl FusionParams {
+    /// The cell's measured force \[N\] (intentional-contact paper eq. (6)): its force signal,
+    /// reduced per `force_reduction`, through the inverse characteristic `force`; `None` when the
+    /// signal is not above `activity_threshold` (no contact).
+    #[inline]
+    pub fn cell_force_n(&self, reading: &CellReading, force: &PreparedForce) -> Option<f64> {
+        let s = reading.force_signal(self.force_reduction);
+        (s > self.activity_threshold).then(|| force.force_n(s))
+    }
+
     /// Checks the declared ranges.
     pub fn validate(&self, prefix: &str) -> Result<(), InvalidParam> {
         self.check(prefix)

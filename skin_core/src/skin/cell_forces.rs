@@ -62,13 +62,7 @@ pub fn cell_contact_forces<'a>(
     out: &mut Vec<PointForce>,
 ) -> Result<(), LengthMismatch> {
     let force = force.prepared();
-    inward_cell_forces(layout, readings, frame_pose, out, |r| {
-        let f = r.force_signal(fusion.force_reduction);
-        if f <= fusion.activity_threshold {
-            return 0.0;
-        }
-        force.force_n(f)
-    })
+    inward_cell_forces(layout, readings, frame_pose, out, |r| fusion.cell_force_n(r, &force).unwrap_or(0.0))
 }
 
 /// The shared loop: every cell whose `magnitude(reading)` is positive gives a force of that

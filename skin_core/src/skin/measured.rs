@@ -62,10 +62,8 @@ pub fn measured_contact(
         let axis_in_patch = pose.rotation.inverse_transform_vector(axis);
         let geometry = &layout.patch_geometry[patch.cells.clone()];
         for (i, r) in live.in_range(patch.cells.clone()) {
-            let s = r.force_signal(fusion.force_reduction);
-            if s > fusion.activity_threshold {
+            if let Some(f_i) = fusion.cell_force_n(r, force) {
                 let g = &geometry[i - patch.cells.start];
-                let f_i = force.force_n(s);
                 c.force_n += g.normal.dot(&axis_in_patch) * f_i; // c_i F_i
                 c.moment_nm += pose.rotation * (g.lever * f_i); // R_j (t_i × n_i) F_i
             }

@@ -94,11 +94,9 @@ impl ContactReactionParams {
         LengthMismatch::check_count(layout, cells.num_cells())?;
         let mut s = ContactSummary::default();
         for (i, reading) in cells.cells() {
-            let sig = reading.force_signal(fusion.force_reduction);
-            if sig <= fusion.activity_threshold {
+            let Some(measured) = fusion.cell_force_n(reading, force) else {
                 continue;
-            }
-            let measured = force.force_n(sig);
+            };
             let f = self.gain * measured;
             row(&layout.cells()[*i], (f, row_activation(measured, self.activation_force_n)))?;
             s.rows += 1;

@@ -105,6 +105,8 @@ fn the_shipped_movable_obstacle_is_still_pushed_to_the_goal() {
     let r = run_variant(|_| {});
     assert_safe("shipped", &r);
     assert_eq!(outcome(&r), "reached");
+    let goal = r.metrics.goal.as_ref().unwrap();
+    assert!(goal.reached_before_pushes(), "by the push at 15 s: {} m before it", goal.goal_error_before_pushes_m);
 }
 
 /// A controller setup in `dir` that is the shipped planar7 one with `contact_reaction` removed

@@ -191,7 +191,10 @@ pub fn failures(r: &SceneResult) -> Vec<String> {
     if let Some(v) = &r.verdict {
         out.extend(v.violations.iter().map(|x| format!("safety: {x}")));
         if r.feasible && v.goal_reached == Some(false) {
-            out.push("goal not reached (feasible)".into());
+            let late = r.metrics.as_ref().and_then(|m| m.get("goal_reached")).and_then(Value::as_bool) == Some(true);
+            out.push(
+                if late { "goal reached only after the push (feasible)" } else { "goal not reached (feasible)" }.into(),
+            );
         }
         if v.force_table3 == Some(false) {
             out.push("Table 3 force error exceeded".into());
@@ -229,7 +232,10 @@ pub fn robustness_md(results: &[SceneResult], s: &Summary, figures: &str) -> Str
          above eps_c (in a force scene's contact phase: above the reference + 2 N) for more than\n\
          0.5 s in one event, or chatter (one arrangement switch more than twice within 10 s). A goal\n\
          scene is feasible when every obstacle slides under eps_c (mu m g < 5 N) and none is fixed;\n\
-         an infeasible one may end `blocked` (the arm gave up the push and holds) if it is safe.\n\n\
+         an infeasible one may end `blocked` (the arm gave up the push and holds) if it is safe. A goal\n\
+         counts as reached when it is within the tolerance at the end and, in a scene with a scripted\n\
+         push on an obstacle (the planar family's, at 15 s), already when the push starts: a goal that\n\
+         only the push cleared the way to was not reached by the controller.\n\n\
          | Figure | Value |\n|---|---|\n\
          | scenes | {} |\n| scenes that could not run | {} |\n| scenes with a safety violation | {} |\n\
          | goal success, feasible scenes | {:.1} % |\n| force scenes within Table 3 | {:.1} % |\n\

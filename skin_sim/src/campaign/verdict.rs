@@ -15,7 +15,8 @@ pub struct Verdict {
     /// Goal scenes: `reached`, `blocked` (the push could not succeed and the arm held) or
     /// `not_reached`.
     pub outcome: Option<&'static str>,
-    /// Goal scenes: the goal was reached.
+    /// Goal scenes: the goal was reached, and before the first push on an object when there is
+    /// one (a goal that only the push cleared the way to was not reached by the controller).
     pub goal_reached: Option<bool>,
     /// Force scenes: the Table 3 checks held.
     pub force_table3: Option<bool>,
@@ -32,7 +33,7 @@ pub fn judge(report: &RunReport) -> Verdict {
     Verdict {
         violations: safety::violations(&m.safety, m.faulted_cycles),
         outcome: m.goal.as_ref().map(|g| g.outcome),
-        goal_reached: m.goal.as_ref().map(|g| g.goal_reached),
+        goal_reached: m.goal.as_ref().map(|g| g.goal_reached && g.reached_before_pushes()),
         force_table3,
         first_contact_overshoot_n: m.force.as_ref().map(|f| f.first_contact_peak_force_n - f.first_contact_reference_n),
     }

@@ -127,6 +127,9 @@ pub struct GoalMetrics {
     pub goal_error_m: f64,
     /// Goal tolerance of the supervisor \[m\].
     pub goal_tolerance_m: f64,
+    /// Goal error when the first push on an object starts \[m\] (null: no push): a goal reached
+    /// only after it was reached through the push, not by the controller.
+    pub goal_error_before_pushes_m: f64,
     /// Largest physical contact force on one link during intentional contact (Table I (b)),
     /// outside the pushes and their recovery allowance (a push starting in (b) is the push's) \[N\].
     pub max_contact_force_intentional_n: f64,
@@ -144,6 +147,14 @@ pub struct GoalMetrics {
     pub outcome: &'static str,
     /// When the supervisor first held the arm as blocked \[s\] (null: never).
     pub blocked_at_s: f64,
+}
+
+impl GoalMetrics {
+    /// Whether the goal was within the tolerance when the first push on an object started (true
+    /// without pushes).
+    pub fn reached_before_pushes(&self) -> bool {
+        self.goal_error_before_pushes_m.is_nan() || self.goal_error_before_pushes_m <= self.goal_tolerance_m
+    }
 }
 
 /// Interactive-force-control paper Table 3: force tracking in the contact phase.
@@ -280,10 +291,16 @@ fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: &Limits) -> GoalM
         })
         .fold(f64::NAN, f64::max);
     let error = cycles.last().map_or(f64::NAN, |c| c.signals.goal_error_m);
+    let first_push = pushes.iter().map(|&(a, _)| a).fold(f64::INFINITY, f64::min);
+    let before_pushes = cycles.iter().take_while(|c| c.t_s < first_push).last();
     GoalMetrics {
         goal_reached: error <= limits.goal_tolerance_m,
         goal_error_m: error,
         goal_tolerance_m: limits.goal_tolerance_m,
+        goal_error_before_pushes_m: match before_pushes {
+            Some(c) if first_push.is_finite() => c.signals.goal_error_m,
+            _ => f64::NAN,
+        },
         max_contact_force_intentional_n: max_link_force(cycles, |c| {
             c.mode == Mode::IntentionalContact && !excused(c.t_s)
         }),

@@ -42,7 +42,7 @@ pub const FIRST_CONTACT_OVERSHOOT_N: f64 = 2.0;
 
 /// The checks of a run. Every run: safe ([`safety::violations`]). What the scene declares
 /// (`expect`; `None`: a scene with goals expects the supervisor's goal tolerance and `ε_c`):
-/// the goal reached, every contact at most `ε_c` outside the pushes and the pushes relieved
+/// the goal reached (and before the first push on an object, when there is one), every contact at most `ε_c` outside the pushes and the pushes relieved
 /// within [`RECOVERY_LIMIT_S`], a peak contact force, the RMS force errors of Table 3; with
 /// `safety`, a run that ends `blocked` (the push could not succeed) passes on safety and the
 /// peak alone. Every scene of its kind:
@@ -79,6 +79,10 @@ pub fn checks(m: &Metrics, expect: Option<&ExpectSpec>) -> Vec<Check> {
         if !(expect.safety && blocked) {
             if let Some(tol) = expect.goal_tolerance_m {
                 out.push(at_most("goal reached", g.goal_error_m, tol, "m"));
+                if !g.goal_error_before_pushes_m.is_nan() {
+                    // by the controller, not by a push that moved the obstacle out of the way
+                    out.push(at_most("goal reached before the first push", g.goal_error_before_pushes_m, tol, "m"));
+                }
             }
             if let Some(eps) = expect.eps_c_n {
                 out.push(at_most("contact force <= eps_c (outside pushes)", g.max_contact_force_n, eps, "N"));
@@ -151,6 +155,7 @@ mod tests {
                 goal_reached: outcome == "reached",
                 goal_error_m: error_m,
                 goal_tolerance_m: 0.01,
+                goal_error_before_pushes_m: f64::NAN,
                 max_contact_force_intentional_n: 3.0,
                 max_contact_force_n: peak_n,
                 eps_c_n: 5.0,
@@ -190,5 +195,17 @@ mod tests {
         chattering.safety.max_switch_repeats_in_window = 3;
         assert_eq!(failed(&chattering, Some(&unreachable)).len(), 1);
         assert!(failed(&goal_run("reached", f64::NAN, 1.0), Some(&declared)).contains(&"goal reached"), "NaN fails");
+    }
+
+    /// A goal that a push on the obstacle cleared the way to fails; one reached before it, or in
+    /// a scene without pushes, passes.
+    #[test]
+    fn a_goal_reached_only_after_the_push_fails() {
+        let mut run = goal_run("reached", 0.0, 1.0);
+        assert!(failed(&run, None).is_empty(), "no push: nothing to check");
+        for (before_m, fails) in [(0.005, false), (0.09, true)] {
+            run.goal.as_mut().unwrap().goal_error_before_pushes_m = before_m;
+            assert_eq!(failed(&run, None).contains(&"goal reached before the first push"), fails, "{before_m} m");
+        }
     }
 }

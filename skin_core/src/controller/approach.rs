@@ -1,6 +1,7 @@
 //! The skin's approach bound (`docs/resolver.md`): for every cell that senses a surface, the
 //! speed at which its point closes on it, `nᵀ J_v(p) q̇`, limited to the bound at the sensed
-//! distance and force, as a limit the resolver meets.
+//! distance and force, as a limit the resolver meets. A link that pushes something that gives
+//! way pushes faster than it touches.
 
 use crate::model::{point_jacobian_along, ModelData, ModelError, RobotModel};
 use crate::resolver::{ApproachParams, ClosingBounds};
@@ -9,22 +10,62 @@ use crate::skin::characteristic::PreparedForce;
 use crate::skin::layout::ResolvedLayout;
 use crate::skin::live::LiveCells;
 
+/// What the active arrangement asks of the skin's contacts (intentional-contact paper Table I).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ContactIntent {
+    /// (b): push what gives way.
+    Push,
+    /// (a), a hard contact a retry follows, and the interactive-force-control paper phases:
+    /// touch at most at the touch speed.
+    Touch,
+    /// A hard contact that ends the push ([`crate::supervisor::Supervisor::releasing`]): press nothing.
+    Release,
+}
+
+/// Contact force levels of intentional-contact paper Table I that the bound reads \[N\].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ContactLevels {
+    /// No contact at or below this (Table I (a): `‖F_c‖ = 0`).
+    pub(crate) zero_n: f64,
+    /// A hard contact is released below this (`ε_c` − band): a push under it gives way.
+    pub(crate) release_n: f64,
+    /// `ε_c`: no cell is pushed into it.
+    pub(crate) limit_n: f64,
+}
+
 /// The rule of the limits, one per cell within the proximity range.
 #[derive(Debug, Clone)]
 pub(crate) struct ApproachBound {
     params: ApproachParams,
-    /// `ε_c` of intentional-contact paper Table I \[N\]: no cell is pushed into it.
-    force_limit_n: f64,
+    levels: ContactLevels,
     force: PreparedForce,
+    /// Per model frame: the speed at contact of the link's cells \[m/s\] (`speed_min_mps` up to
+    /// `push_speed_max_mps` while the link pushes something that gives way).
+    push_mps: Vec<f64>,
+    /// Scratch per model frame: the force on the link's cells this cycle \[N\].
+    pressed_n: Vec<f64>,
     /// Scratch: one cell's row.
     row: Vec<f64>,
 }
 
 impl ApproachBound {
-    /// The bound on a model with `nv` joints; no cell is pushed into a force of `force_limit_n`
-    /// (`ε_c`), read through `force`.
-    pub(crate) fn new(params: ApproachParams, force_limit_n: f64, force: PreparedForce, nv: usize) -> Self {
-        Self { params, force_limit_n, force, row: vec![0.0; nv] }
+    /// The bound on a model with `nv` joints and `nframes` frames; the contact `levels` are read
+    /// through `force`.
+    pub(crate) fn new(
+        params: ApproachParams,
+        levels: ContactLevels,
+        force: PreparedForce,
+        nv: usize,
+        nframes: usize,
+    ) -> Self {
+        Self {
+            params,
+            levels,
+            force,
+            push_mps: vec![params.speed_min_mps; nframes],
+            pressed_n: vec![0.0; nframes],
+            row: vec![0.0; nv],
+        }
     }
 
     /// Room for the limits of a layout with `cells` cells.
@@ -33,11 +74,17 @@ impl ApproachBound {
     }
 
     /// Sets `bounds` to the limits for the cells' readings at the state of the last kinematics
-    /// update: the outward normal's row (closing is positive) and `v_t + d / time` for distance
-    /// `d`. The touch speed `v_t` is `speed_min`, and 0 for a cell pressed at `ε_c` or more and in
-    /// a hard contact that ends the push (`releasing`, [`crate::supervisor::Supervisor::releasing`]):
-    /// nothing drives the body back into a contact the reaction relieves (the goal below the
-    /// reaction did, a limit cycle of touches for the rest of the run).
+    /// update, `dt_s` after the last: the outward normal's row (closing is positive) and
+    /// `v_c + d / time` for distance `d`. The speed at contact `v_c` of a link's cells is
+    /// - 0 for a cell pressed at `ε_c` or more, and in a hard contact that ends the push
+    ///   ([`ContactIntent::Release`]): nothing drives the body back into a contact the reaction
+    ///   relieves (the goal below the reaction did, a limit cycle of touches for the rest of the run);
+    /// - in a push ([`ContactIntent::Push`]), growing by `push_accel_mps2` up to
+    ///   `push_speed_max_mps` while the link is pressed between no contact and the release level
+    ///   of a hard contact: it pushes something that slides (a push at the touch speed would take
+    ///   10 s for 20 cm); falling back as fast when the pushed thing slid ahead out of contact,
+    ///   and at once to the touch speed when the link is pressed at that level;
+    /// - otherwise the touch speed `speed_min_mps`.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn update(
         &mut self,
@@ -46,26 +93,46 @@ impl ApproachBound {
         layout: &ResolvedLayout,
         cells: &LiveCells,
         fusion: &FusionParams,
-        releasing: bool,
+        intent: ContactIntent,
+        dt_s: f64,
         bounds: &mut ClosingBounds,
     ) -> Result<(), ModelError> {
         bounds.clear();
         if !self.params.enabled {
             return Ok(());
         }
-        let p = &self.params;
+        let (p, levels) = (&self.params, self.levels);
+        self.pressed_n.fill(0.0);
+        for (i, reading) in cells.cells() {
+            if let Some(f) = fusion.cell_force_n(reading, &self.force) {
+                self.pressed_n[layout.cells()[*i].frame] += f;
+            }
+        }
+        let dt = if dt_s.is_finite() { dt_s.max(0.0) } else { 0.0 };
+        let (touch, fastest, dv) = (p.speed_min_mps, p.push_speed_max_mps.max(p.speed_min_mps), p.push_accel_mps2 * dt);
+        for (v, &f) in self.push_mps.iter_mut().zip(&self.pressed_n) {
+            *v = if intent != ContactIntent::Push {
+                touch
+            } else if f > levels.zero_n && f < levels.release_n {
+                (*v + dv).min(fastest)
+            } else if f <= levels.zero_n {
+                (*v - dv).max(touch) // a pushed object that slid ahead: the push goes on
+            } else {
+                touch // NaN too
+            };
+        }
         let range = cells.proximity_range_m();
         // a cell without proximity signal is at the range: it senses nothing
         for ((i, reading), &d) in cells.cells().iter().zip(cells.distances()) {
             if d >= range {
                 continue;
             }
-            let at_limit = fusion.cell_force_n(reading, &self.force).is_some_and(|f| f >= self.force_limit_n);
-            let touch = if releasing || at_limit { 0.0 } else { p.speed_min_mps };
             let cell = &layout.cells()[*i];
+            let at_limit = fusion.cell_force_n(reading, &self.force).is_some_and(|f| f >= levels.limit_n);
+            let contact = if intent == ContactIntent::Release || at_limit { 0.0 } else { self.push_mps[cell.frame] };
             let outward = data.frame_pose(cell.frame).rotation * cell.normal_link;
             point_jacobian_along(model, data, cell.frame, &cell.position_link, &outward, &mut self.row)?;
-            bounds.push(&self.row, touch + d / p.time_s);
+            bounds.push(&self.row, contact + d / p.time_s);
         }
         Ok(())
     }

@@ -2,7 +2,7 @@
 
 use nalgebra::{DMatrix, DVector, Isometry3};
 
-use super::approach::ApproachBound;
+use super::approach::{ApproachBound, ContactIntent, ContactLevels};
 use super::io::{ControllerInput, ControllerOutput, Fault};
 use super::setup::{ControllerConfig, HierarchyDynamics, SetupError};
 use super::stages::{Stage, StageClock, StageTimes};
@@ -16,7 +16,7 @@ use crate::skin::live::LiveCells;
 use crate::skin::measured::measured_contact;
 use crate::skin::transforms::{patch_poses_world, patch_wrench_world, sum_patch_forces_in_frame};
 use crate::supervisor::blend::chi;
-use crate::supervisor::{Arrangement, Imposed, Phase, PhaseRefused, Supervisor, SupervisorInput, TorqueBlender};
+use crate::supervisor::{Arrangement, Imposed, Mode, Phase, PhaseRefused, Supervisor, SupervisorInput, TorqueBlender};
 use crate::tasks::avoidance::ProximityAvoidance;
 use crate::tasks::contact_reaction::ContactReaction;
 use crate::tasks::{BaseReference, Cycle, HandSignals, TaskEntry, TaskSetup};
@@ -147,8 +147,14 @@ impl Controller {
             .map_err(|error| SetupError::Inverse { file: config.source.clone(), error })?;
         let mut resolver = Resolver::with_held(model, config.resolver.clone(), &locked)
             .map_err(|error| SetupError::Resolver { file: config.setup.resolver.display().to_string(), error })?;
-        let eps_c = config.supervisor.thresholds.contact_force_n;
-        let approach = ApproachBound::new(config.resolver.approach, eps_c, config.skin.force.prepared(), nv);
+        let th = &config.supervisor.thresholds;
+        let levels = ContactLevels {
+            zero_n: th.contact_zero_n,
+            release_n: th.contact_force_n - th.contact_band_n,
+            limit_n: th.contact_force_n,
+        };
+        let force = config.skin.force.prepared();
+        let approach = ApproachBound::new(config.resolver.approach, levels, force, nv, model.nframes());
         *resolver.closing_bounds_mut() = approach.limits(config.layout.num_cells());
         let supervisor = Supervisor::new(&config.supervisor, t0_s)?;
         let output = ControllerOutput {
@@ -491,10 +497,15 @@ impl Controller {
         self.clock.lap(Stage::Hierarchy);
 
         // 5. admittance resolver, within the skin's approach bound
-        let (live, releasing) = (&self.live, self.supervisor.releasing());
+        let intent = match self.supervisor.mode() {
+            _ if self.supervisor.releasing() => ContactIntent::Release,
+            Mode::IntentionalContact => ContactIntent::Push,
+            _ => ContactIntent::Touch,
+        };
+        let live = &self.live;
         let bounds = self.resolver.closing_bounds_mut();
         self.approach
-            .update(model, &self.data, layout, live, &self.fusion, releasing, bounds)
+            .update(model, &self.data, layout, live, &self.fusion, intent, input.dt_s, bounds)
             .map_err(stage("approach bound"))?;
         self.resolver
             .update(self.tau.as_slice(), self.gravity.as_slice(), input.q, input.qd, input.dt_s)

@@ -395,3 +395,60 @@ fn no_skin_point_closes_on_a_sensed_surface_faster_than_the_approach_bound() {
     let runs = drive_among_surfaces(Controller::new(shipped, 0.0).unwrap());
     assert!(max(&runs[10..], |c| c.1) < 1e-3, "after the start: {} m/s over", max(&runs[10..], |c| c.1));
 }
+
+/// The speed at contact of a link's cells (the limit at `d = 0`): the touch speed, growing by
+/// the push acceleration up to the fastest push while the link is pressed between no contact
+/// and the release level of a hard contact in a push (b); falling back as fast when the link is
+/// out of contact; back at the touch speed at once when it is pressed at that level and in any
+/// other arrangement; 0 for a cell at `ε_c` and when the contact is to be released.
+#[test]
+fn a_link_pushing_what_gives_way_pushes_faster_than_it_touches() {
+    use super::approach::{ApproachBound, ContactIntent, ContactLevels};
+    use crate::skin::live::LiveCells;
+    let config = ControllerConfig::load(&setup("planar7")).unwrap();
+    let (model, layout, skin) = (&config.model, &config.layout, &config.skin);
+    let (p, th) = (config.resolver.approach, config.supervisor.thresholds);
+    let release_n = th.contact_force_n - th.contact_band_n;
+    let levels = ContactLevels { zero_n: th.contact_zero_n, release_n, limit_n: th.contact_force_n };
+    let mut bound = ApproachBound::new(p, levels, skin.force.prepared(), model.nv(), model.nframes());
+    let mut limits = bound.limits(layout.num_cells());
+    let mut data = crate::model::ModelData::new(model);
+    crate::model::update_kinematics(model, &mut data, &config.setup.posture, &vec![0.0; model.nv()]).unwrap();
+    let pressed = 0;
+    let frame = layout.cells()[pressed].frame;
+    let dt = 0.01;
+    // every cell touches a surface (d = 0), the first one pressed with `force_n`: the speeds at
+    // contact of the first cell, of another cell of its link and of a cell of another link
+    let mut step = |force_n: f64, intent: ContactIntent| {
+        let readings: Vec<CellReading> = (0..layout.num_cells())
+            .map(|i| CellReading::uniform(if i == pressed { skin.force.signal(force_n) } else { 0.0 }, 1.0))
+            .collect();
+        let live = LiveCells::from_readings(&readings, &skin.proximity);
+        bound.update(model, &data, layout, &live, &skin.fusion, intent, dt, &mut limits).unwrap();
+        let speeds: Vec<f64> = limits.iter().map(|(_, b)| b).collect();
+        assert_eq!(speeds.len(), layout.num_cells(), "every touching cell has a limit");
+        let on_link = (1..speeds.len()).find(|&i| layout.cells()[i].frame == frame).unwrap();
+        let elsewhere = (0..speeds.len()).find(|&i| layout.cells()[i].frame != frame).unwrap();
+        (speeds[pressed], speeds[on_link], speeds[elsewhere])
+    };
+    let (touch, fastest, a) = (p.speed_min_mps, p.push_speed_max_mps, p.push_accel_mps2);
+    let push_n = 0.5 * (th.contact_zero_n + release_n);
+    assert!(touch + 10.0 * a * dt < fastest, "the ramp is seen before it saturates");
+    let mut last = (0.0, 0.0, 0.0);
+    for k in 1..=10 {
+        last = step(push_n, ContactIntent::Push);
+        let v = touch + k as f64 * a * dt;
+        assert!((last.0 - v).abs() < 1e-9 && (last.1 - v).abs() < 1e-9, "step {k}: {last:?}, expected {v}");
+        assert_eq!(last.2, touch, "another link touches");
+    }
+    for _ in 0..((fastest / (a * dt)) as usize) {
+        last = step(push_n, ContactIntent::Push);
+    }
+    assert_eq!(last.0, fastest, "the fastest push");
+    assert!((step(0.0, ContactIntent::Push).0 - (fastest - a * dt)).abs() < 1e-9, "out of contact: falls back");
+    assert_eq!(step(release_n + 0.1, ContactIntent::Push).0, touch, "at the release level: the touch");
+    step(push_n, ContactIntent::Push);
+    assert_eq!(step(push_n, ContactIntent::Touch).0, touch, "no push outside (b)");
+    assert_eq!(step(push_n, ContactIntent::Release), (0.0, 0.0, 0.0), "releasing: nothing closes");
+    assert_eq!(step(th.contact_force_n, ContactIntent::Push).0, 0.0, "no cell is pushed into eps_c");
+}

@@ -36,17 +36,32 @@ declare_params! {
     pub struct ApproachParams {
         /// Whether the bound is applied.
         pub enabled: bool => { choices: "true | false", live: false },
-        /// Closing speed allowed at contact (`d = 0`): also the fastest push into a surface.
+        /// Closing speed allowed at contact (`d = 0`): the touch, and the start of a push.
         pub speed_min_mps: f64 => { unit: "m/s", range: Range::positive(10.0), live: false },
         /// Time in which the allowed closing speed would cover the sensed distance.
         pub time_s: f64 => { unit: "s", range: Range::positive(100.0), live: false },
+        /// A link in contact below the release level of a hard contact pushes something that
+        /// gives way: its speed at contact grows from `speed_min_mps` by this much per second.
+        #[serde(default = "default_push_accel")]
+        pub push_accel_mps2: f64 => { unit: "m/s²", range: Range::closed(0.0, 100.0), live: false },
+        /// The fastest push into a surface that gives way.
+        #[serde(default = "default_push_speed_max")]
+        pub push_speed_max_mps: f64 => { unit: "m/s", range: Range::positive(10.0), live: false },
     }
+}
+
+fn default_push_accel() -> f64 {
+    ApproachParams::default().push_accel_mps2
+}
+
+fn default_push_speed_max() -> f64 {
+    ApproachParams::default().push_speed_max_mps
 }
 
 impl Default for ApproachParams {
     /// The shipped values (`config/resolver.yaml`).
     fn default() -> Self {
-        Self { enabled: true, speed_min_mps: 0.02, time_s: 0.5 }
+        Self { enabled: true, speed_min_mps: 0.02, time_s: 0.5, push_accel_mps2: 0.1, push_speed_max_mps: 0.06 }
     }
 }
 

@@ -30,26 +30,41 @@ impl Dwell {
     }
 }
 
-/// The goal error at the start of the current progress window, and whether the last full
-/// window made too little progress (a crawl that the speed test misses).
+/// Checkpoints per progress window: the window slides by a sixth of its length.
+const CHECKPOINTS: usize = 6;
+
+/// The goal error at the checkpoints of the last progress window, and whether it fell too little
+/// over that window (a crawl that the speed test misses).
 #[derive(Debug, Clone, Copy)]
 struct Progress {
-    since: f64,
-    error_m: f64,
+    /// Time of the next checkpoint (NaN: the next sample starts a window).
+    next_s: f64,
+    /// Goal errors at the last checkpoints; `head` is the next one written (the oldest once full).
+    errors: [f64; CHECKPOINTS],
+    count: usize,
+    head: usize,
     crawling: bool,
 }
 
 impl Progress {
-    const IDLE: Progress = Progress { since: f64::NAN, error_m: f64::NAN, crawling: false };
+    const IDLE: Progress =
+        Progress { next_s: f64::NAN, errors: [f64::NAN; CHECKPOINTS], count: 0, head: 0, crawling: false };
 
-    /// Advances to `t` with the goal error `e`; NaN restarts the window.
+    /// Advances to `t` with the goal error `e`: crawling when the error fell by less than `min_m`
+    /// over the last `window_s` (checked every sixth of it, so a crawl is seen at most a sixth
+    /// of a window late, not a whole window); NaN restarts the window.
     fn step(&mut self, t: f64, e: f64, window_s: f64, min_m: f64) -> bool {
-        if e.is_nan() || self.since.is_nan() {
-            *self = Progress { since: if e.is_nan() { f64::NAN } else { t }, error_m: e, crawling: false };
-        } else if t - self.since >= window_s {
-            self.crawling = self.error_m - e < min_m;
-            self.since = t;
-            self.error_m = e;
+        if e.is_nan() {
+            *self = Progress::IDLE;
+        } else if self.next_s.is_nan() || t >= self.next_s {
+            if self.count == CHECKPOINTS {
+                self.crawling = self.errors[self.head] - e < min_m; // the one a window ago
+            } else {
+                self.count += 1;
+            }
+            self.errors[self.head] = e;
+            self.head = (self.head + 1) % CHECKPOINTS;
+            self.next_s = t + window_s / CHECKPOINTS as f64;
         }
         self.crawling
     }

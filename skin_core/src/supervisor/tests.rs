@@ -749,7 +749,8 @@ fn follower_reproduces_the_deciding_supervisor() {
 }
 
 /// A crawl along an obstacle, faster than ε_v but getting nearer the goal slower than
-/// `crawl_speed_mps`, counts as stuck after the progress window (and the stuck dwell); the same
+/// `crawl_speed_mps`, counts as stuck one progress window after it began (and a sixth of a
+/// window, the window's step, and the stuck dwell), wherever it begins in a window; the same
 /// speed with the goal error falling twice as fast as `crawl_speed_mps` never does.
 #[test]
 fn a_crawl_without_goal_progress_is_stuck() {
@@ -762,7 +763,7 @@ fn a_crawl_without_goal_progress_is_stuck() {
     // the goal error falls at twice the crawl speed: progress
     let rate = 2.0 * th.crawl_speed_mps;
     assert!(rate < speed, "the goal cannot come nearer faster than the end effector moves");
-    for _ in 0..steps(4.0 * th.progress_window_s) {
+    for _ in 0..steps(4.5 * th.progress_window_s) {
         t += DT;
         sup.update(t, &input(speed, 3.0, 0.0, 1.0 - rate * t));
         assert_eq!(sup.last_transition(), None, "progress is not a local minimum (t = {t})");
@@ -770,7 +771,8 @@ fn a_crawl_without_goal_progress_is_stuck() {
     // then it crawls at the same speed, the goal error falling at half the crawl speed
     let (t0, e0) = (t, 1.0 - rate * t);
     let mut tr = Vec::new();
-    for _ in 0..steps(2.0 * th.progress_window_s + p.dwell.stuck_s) {
+    // (a window fixed in time would see it only at the end of the next whole window, 1.5 windows)
+    for _ in 0..steps(7.0 / 6.0 * th.progress_window_s + p.dwell.stuck_s) + 1 {
         t += DT;
         sup.update(t, &input(speed, 3.0, 0.0, e0 - 0.5 * th.crawl_speed_mps * (t - t0)));
         tr.extend(sup.last_transition());

@@ -74,7 +74,7 @@ def expected(ts):
         ("/supervisor/arrangement", 9 * S, T["skin_msgs/msg/Arrangement"](
             mode=1, task_order=["goal", "contact_reaction", "avoidance"],
             switch_time=Time(sec=8, nanosec=500_000_000), smoothing_gain=5.0, sensing_range=0.05,
-            fusion_weight=0.75)),
+            fusion_weight=0.75, releasing=True)),
         ("/controller/state", 10 * S, T["skin_msgs/msg/ControllerState"](
             header=header(10, ""), mode=2, blend=0.3, ee_speed=0.012, avoidance_force=1.5,
             contact_force=12.5, torque_norm=42.0, goal_error=-1.0, tasks=[

@@ -142,6 +142,7 @@ fn samples(v: &mut impl Visit) -> Result<()> {
             smoothing_gain: 5.0,
             sensing_range: 0.05,
             fusion_weight: 0.75,
+            releasing: true,
         },
     )?;
     v.visit(

@@ -307,6 +307,8 @@ pub struct Arrangement {
     pub sensing_range: f64,
     /// Fusion weight, \[0, 1\].
     pub fusion_weight: f64,
+    /// In a hard contact: to be relieved, not pressed again.
+    pub releasing: bool,
 }
 
 /// `skin_msgs/TaskState`.

@@ -41,7 +41,7 @@ impl PrioritySupervisor {
 
     /// The active arrangement as a message.
     pub fn current(&self) -> ArrangementMsg {
-        arrangement_msg(self.sup.arrangement(), self.sup.tasks())
+        arrangement_msg(self.sup.arrangement(), self.sup.tasks(), self.sup.releasing())
     }
 
     /// Takes one controller state; returns the arrangement to publish when it differs from the

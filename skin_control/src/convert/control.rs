@@ -183,8 +183,9 @@ pub fn supervisor_input(msg: &ControllerState) -> (f64, skin_core::supervisor::S
     )
 }
 
-/// The message of an arrangement (`tasks`: the configured task names).
-pub fn arrangement_msg(a: &Arrangement, tasks: &[String]) -> ArrangementMsg {
+/// The message of an arrangement (`tasks`: the configured task names; `releasing`:
+/// [`skin_core::supervisor::Supervisor::releasing`]).
+pub fn arrangement_msg(a: &Arrangement, tasks: &[String], releasing: bool) -> ArrangementMsg {
     ArrangementMsg {
         mode: a.mode.as_u8(),
         task_order: a.task_names(tasks).map(str::to_string).collect(),
@@ -192,6 +193,7 @@ pub fn arrangement_msg(a: &Arrangement, tasks: &[String]) -> ArrangementMsg {
         smoothing_gain: a.smoothing_gain_per_s,
         sensing_range: a.sensing_range_m,
         fusion_weight: a.fusion_weight_target,
+        releasing,
     }
 }
 
@@ -222,6 +224,7 @@ pub fn imposed_of(msg: &ArrangementMsg, configured: impl Fn(Mode) -> Vec<String>
         switch_time_s: time_s(&msg.switch_time),
         sensing_range_m: msg.sensing_range,
         fusion_weight_target: msg.fusion_weight,
+        releasing: msg.releasing,
     })
 }
 
@@ -271,6 +274,7 @@ mod tests {
             smoothing_gain: 10.0,
             sensing_range: 0.05,
             fusion_weight: 0.5,
+            releasing: true,
         };
         let cfg = |m: Mode| {
             if m == Mode::IntentionalContact {
@@ -281,6 +285,7 @@ mod tests {
         };
         let a = imposed_of(&msg, cfg).unwrap();
         assert_eq!((a.mode, a.switch_time_s, a.sensing_range_m), (Mode::IntentionalContact, 2.5, 0.05));
+        assert!(a.releasing);
         let bad = ArrangementMsg { mode: 9, ..msg.clone() };
         assert_eq!(imposed_of(&bad, cfg).unwrap_err(), "mode = 9: not an Arrangement.MODE_* constant");
         let bad = ArrangementMsg { mode: 0, ..msg };

@@ -162,6 +162,7 @@ impl Controller {
             fault: None,
             mode: supervisor.mode(),
             blocked: None,
+            releasing: false,
             blend: 0.0,
             fusion_weight: config.skin.fusion.weight_force,
             signals: SupervisorInput::default(),
@@ -493,12 +494,13 @@ impl Controller {
         };
         self.output.mode = arrangement.mode;
         self.output.blocked = self.supervisor.blocked();
+        self.output.releasing = self.supervisor.releasing();
         self.output.torque_norm = self.tau.norm();
         self.clock.lap(Stage::Hierarchy);
 
         // 5. admittance resolver, within the skin's approach bound
         let intent = match self.supervisor.mode() {
-            _ if self.supervisor.releasing() => ContactIntent::Release,
+            _ if self.output.releasing => ContactIntent::Release,
             Mode::IntentionalContact => ContactIntent::Push,
             _ => ContactIntent::Touch,
         };

@@ -110,6 +110,8 @@ pub struct Supervisor {
     /// Following another supervisor ([`Supervisor::impose`]): its own rules are off.
     follower: bool,
     imposed: Option<Imposed>,
+    /// A follower's: the deciding supervisor's `releasing` of the imposed arrangement.
+    imposed_releasing: bool,
 }
 
 impl Supervisor {
@@ -164,6 +166,7 @@ impl Supervisor {
             log: TransitionLog::new(params.log_capacity),
             follower: false,
             imposed: None,
+            imposed_releasing: false,
         })
     }
 
@@ -250,6 +253,7 @@ impl Supervisor {
             self.switch(a.switch_time_s, a.mode, Cause::Imposed);
         }
         self.arrangement.sensing_range_m = a.sensing_range_m;
+        self.imposed_releasing = a.releasing;
     }
 
     /// The active arrangement.
@@ -279,10 +283,11 @@ impl Supervisor {
 
     /// In a hard contact (c) that no push follows (entered from (a), or from (b) without a
     /// retry): the contact is to be relieved, not pressed again (the skin's approach bound lets
-    /// nothing close on a sensed surface then, `docs/resolver.md`). A follower
-    /// ([`Self::impose`]) cannot tell a retry from the arrangement it is given: every (c) counts.
+    /// nothing close on a sensed surface then, `docs/resolver.md`). A follower ([`Self::impose`])
+    /// has the deciding supervisor's.
     pub fn releasing(&self) -> bool {
-        self.arrangement.mode == Mode::HardContact && !(self.resume == Mode::IntentionalContact && self.retry)
+        let own = !(self.resume == Mode::IntentionalContact && self.retry);
+        self.arrangement.mode == Mode::HardContact && if self.follower { self.imposed_releasing } else { own }
     }
 
     /// The goal changed: a push that was given up may succeed toward the new goal, so the

@@ -710,13 +710,16 @@ fn follower_reproduces_the_deciding_supervisor() {
         let mut follower = Supervisor::new(&params, 0.0).unwrap();
         let mut t = 0.0;
         let mut rng = Rng(3);
+        let mut seen = [false; 2]; // hard contacts with a retry, released
         for k in 0..3000 {
             t += 0.008;
             if k == 500 {
                 let _ = decider.request_phase(Phase::Contact);
             }
-            let fc = if (1500..1800).contains(&k) { 8.0 } else { 0.0 };
-            let u = input(0.002 * rng.next().abs(), 2.0, fc, 0.3);
+            // two hard contacts in (b): the first after the push got the goal nearer (a retry
+            // follows), the second too soon after it (released)
+            let fc = if (1500..1800).contains(&k) || (2200..2400).contains(&k) { 8.0 } else { 0.0 };
+            let u = input(0.002 * rng.next().abs(), 2.0, fc, 0.3 - 1e-5 * k as f64);
             let a = decider.update(t, &u).clone();
             follower
                 .impose(Imposed {
@@ -724,6 +727,7 @@ fn follower_reproduces_the_deciding_supervisor() {
                     switch_time_s: a.switch_time_s,
                     sensing_range_m: a.sensing_range_m,
                     fusion_weight_target: a.fusion_weight_target,
+                    releasing: decider.releasing(),
                 })
                 .unwrap();
             let f = follower.update(t, &SupervisorInput::default()).clone();
@@ -731,8 +735,10 @@ fn follower_reproduces_the_deciding_supervisor() {
             assert_eq!(f.task_order(), a.task_order());
             assert_eq!(f.switch_time_s.to_bits(), a.switch_time_s.to_bits());
             assert_eq!(f.sensing_range_m, a.sensing_range_m);
-            // the imposed arrangement does not say whether a retry follows: every (c) releases
-            assert_eq!(follower.releasing(), f.mode == Mode::HardContact, "cycle {k}");
+            assert_eq!(follower.releasing(), decider.releasing(), "cycle {k}");
+            if f.mode == Mode::HardContact {
+                seen[usize::from(follower.releasing())] = true;
+            }
             assert!(
                 (f.fusion_weight - a.fusion_weight).abs() < 1e-12,
                 "cycle {k}: w {} vs {}",
@@ -741,10 +747,18 @@ fn follower_reproduces_the_deciding_supervisor() {
             );
         }
         assert!(decider.log().total() >= 1, "{:?}: something switched", params.policy);
+        if params.policy == Policy::IntentionalContact {
+            assert_eq!(seen, [true, true], "both kinds of hard contact followed");
+        }
     }
     let mut s = Supervisor::new(&params(), 0.0).unwrap();
-    let bad =
-        Imposed { mode: Mode::Avoidance, switch_time_s: f64::NAN, sensing_range_m: 0.1, fusion_weight_target: 0.0 };
+    let bad = Imposed {
+        mode: Mode::Avoidance,
+        switch_time_s: f64::NAN,
+        sensing_range_m: 0.1,
+        fusion_weight_target: 0.0,
+        releasing: false,
+    };
     assert!(s.impose(bad).is_err());
 }
 

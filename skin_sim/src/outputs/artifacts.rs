@@ -251,8 +251,13 @@ fn nanos(t_s: f64) -> u64 {
     (t_s.max(0.0) * 1e9).round() as u64
 }
 
-fn arrangement_msg(mode: Mode, t_s: f64) -> Arrangement {
-    Arrangement { mode: mode.as_u8(), switch_time: Time::from_nanos(nanos(t_s)), ..Default::default() }
+fn arrangement_msg(c: &CycleRecord, t_s: f64) -> Arrangement {
+    Arrangement {
+        mode: c.mode.as_u8(),
+        switch_time: Time::from_nanos(nanos(t_s)),
+        releasing: c.releasing,
+        ..Default::default()
+    }
 }
 
 fn write_view_frame(bag: &mut BagWriter, view: &View, f: &KeyFrame) -> anyhow::Result<()> {
@@ -278,7 +283,7 @@ impl RunOutput for RunBag {
         distinct.dedup();
         let has_base = r.joint_names.iter().any(|j| j == "base_x_joint");
         if let Some(first) = r.cycles.first() {
-            bag.write("/supervisor/arrangement", nanos(first.t_s), &arrangement_msg(first.mode, first.t_s))?;
+            bag.write("/supervisor/arrangement", nanos(first.t_s), &arrangement_msg(first, first.t_s))?;
         }
         let view = &r.view;
         bag.add_topic(
@@ -332,7 +337,7 @@ impl RunOutput for RunBag {
             };
             bag.write("/controller/state", ns, &state)?;
             while let Some(sw) = switches.next_if(|sw| sw.t_s <= c.t_s) {
-                bag.write("/supervisor/arrangement", ns, &arrangement_msg(sw.to, sw.t_s))?;
+                bag.write("/supervisor/arrangement", ns, &arrangement_msg(c, sw.t_s))?;
             }
             while let Some(f) = frames.next_if(|f| f.t_s <= c.t_s) {
                 write_view_frame(&mut bag, view, f)?;

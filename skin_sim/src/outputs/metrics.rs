@@ -397,6 +397,7 @@ mod tests {
             base_twist: [0.0; 3],
             mode: Mode::Contact,
             blocked: false,
+            releasing: false,
             blend: 0.0,
             fusion_weight: 1.0,
             signals: SupervisorInput {

@@ -28,6 +28,10 @@ pub struct CycleRecord {
     /// (`skin_core::supervisor::Blocked`); always false when the controller ran elsewhere
     /// (`ControllerState.msg` does not carry it yet).
     pub blocked: bool,
+    /// In a hard contact (c) that is to be relieved, not pressed again
+    /// (`skin_core::supervisor::Supervisor::releasing`); always false when the controller ran
+    /// elsewhere (`ControllerState.msg` does not carry it).
+    pub releasing: bool,
     /// `χ` of intentional-contact paper eq. (10)-(11), 0 outside a blend.
     pub blend: f64,
     /// Fusion weight `w(t)` of interactive-force-control paper eq. (6) the skin was fused with.

@@ -183,6 +183,7 @@ impl ClosedLoop {
             base_twist: out.commands.base_twist,
             mode: out.mode,
             blocked: out.blocked.is_some(),
+            releasing: out.releasing,
             blend: out.blend,
             fusion_weight: out.fusion_weight,
             signals: out.signals,

@@ -198,7 +198,8 @@ impl ExternalRun {
             joint_velocities: decision.joint_velocities,
             base_twist: decision.base_twist,
             mode: decision.mode,
-            blocked: false, // not in ControllerState.msg yet
+            blocked: false,   // not in ControllerState.msg yet
+            releasing: false, // nor this
             blend: decision.blend,
             fusion_weight: decision.fusion_weight,
             signals: decision.signals,

@@ -9,6 +9,7 @@ use crate::skin::aggregate::FusionParams;
 use crate::skin::characteristic::PreparedForce;
 use crate::skin::layout::ResolvedLayout;
 use crate::skin::live::LiveCells;
+use crate::supervisor::Thresholds;
 
 /// What the active arrangement asks of the skin's contacts (intentional-contact paper Table I).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -33,6 +34,17 @@ pub(crate) struct ContactLevels {
     pub(crate) limit_n: f64,
 }
 
+impl ContactLevels {
+    /// The levels of the supervisor's thresholds.
+    pub(crate) fn of(th: &Thresholds) -> Self {
+        Self {
+            zero_n: th.contact_zero_n,
+            release_n: th.contact_force_n - th.contact_band_n,
+            limit_n: th.contact_force_n,
+        }
+    }
+}
+
 /// The rule of the limits, one per cell within the proximity range.
 #[derive(Debug, Clone)]
 pub(crate) struct ApproachBound {
@@ -44,19 +56,22 @@ pub(crate) struct ApproachBound {
     push_mps: Vec<f64>,
     /// Scratch per model frame: the force on the link's cells this cycle \[N\].
     pressed_n: Vec<f64>,
+    /// Scratch per live cell: its measured force this cycle \[N\] (0 below the threshold).
+    forces_n: Vec<f64>,
     /// Scratch: one cell's row.
     row: Vec<f64>,
 }
 
 impl ApproachBound {
-    /// The bound on a model with `nv` joints and `nframes` frames; the contact `levels` are read
-    /// through `force`.
+    /// The bound on a model with `nv` joints and `nframes` frames and a layout of `cells` cells;
+    /// the contact `levels` are read through `force`.
     pub(crate) fn new(
         params: ApproachParams,
         levels: ContactLevels,
         force: PreparedForce,
         nv: usize,
         nframes: usize,
+        cells: usize,
     ) -> Self {
         Self {
             params,
@@ -64,13 +79,15 @@ impl ApproachBound {
             force,
             push_mps: vec![params.speed_min_mps; nframes],
             pressed_n: vec![0.0; nframes],
+            forces_n: Vec::with_capacity(cells),
             row: vec![0.0; nv],
         }
     }
 
-    /// Room for the limits of a layout with `cells` cells.
-    pub(crate) fn limits(&self, cells: usize) -> ClosingBounds {
-        ClosingBounds::with_capacity(self.row.len(), if self.params.enabled { cells } else { 0 })
+    /// Room for the limits of every cell of the layout.
+    pub(crate) fn limits(&self) -> ClosingBounds {
+        let rows = if self.params.enabled { self.forces_n.capacity() } else { 0 };
+        ClosingBounds::with_capacity(self.row.len(), rows)
     }
 
     /// Sets `bounds` to the limits for the cells' readings at the state of the last kinematics
@@ -103,13 +120,14 @@ impl ApproachBound {
         }
         let (p, levels) = (&self.params, self.levels);
         self.pressed_n.fill(0.0);
+        self.forces_n.clear(); // within capacity: one per layout cell at most
         for (i, reading) in cells.cells() {
-            if let Some(f) = fusion.cell_force_n(reading, &self.force) {
-                self.pressed_n[layout.cells()[*i].frame] += f;
-            }
+            let f = fusion.cell_force_n(reading, &self.force).unwrap_or(0.0);
+            self.pressed_n[layout.cells()[*i].frame] += f;
+            self.forces_n.push(f);
         }
         let dt = if dt_s.is_finite() { dt_s.max(0.0) } else { 0.0 };
-        let (touch, fastest, dv) = (p.speed_min_mps, p.push_speed_max_mps.max(p.speed_min_mps), p.push_accel_mps2 * dt);
+        let (touch, fastest, dv) = (p.speed_min_mps, p.push_speed_max_mps, p.push_accel_mps2 * dt);
         for (v, &f) in self.push_mps.iter_mut().zip(&self.pressed_n) {
             *v = if intent != ContactIntent::Push {
                 touch
@@ -123,12 +141,12 @@ impl ApproachBound {
         }
         let range = cells.proximity_range_m();
         // a cell without proximity signal is at the range: it senses nothing
-        for ((i, reading), &d) in cells.cells().iter().zip(cells.distances()) {
+        for (((i, _), &d), &f) in cells.cells().iter().zip(cells.distances()).zip(&self.forces_n) {
             if d >= range {
                 continue;
             }
             let cell = &layout.cells()[*i];
-            let at_limit = fusion.cell_force_n(reading, &self.force).is_some_and(|f| f >= levels.limit_n);
+            let at_limit = f >= levels.limit_n;
             let contact = if intent == ContactIntent::Release || at_limit { 0.0 } else { self.push_mps[cell.frame] };
             let outward = data.frame_pose(cell.frame).rotation * cell.normal_link;
             point_jacobian_along(model, data, cell.frame, &cell.position_link, &outward, &mut self.row)?;

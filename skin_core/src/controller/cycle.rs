@@ -147,15 +147,11 @@ impl Controller {
             .map_err(|error| SetupError::Inverse { file: config.source.clone(), error })?;
         let mut resolver = Resolver::with_held(model, config.resolver.clone(), &locked)
             .map_err(|error| SetupError::Resolver { file: config.setup.resolver.display().to_string(), error })?;
-        let th = &config.supervisor.thresholds;
-        let levels = ContactLevels {
-            zero_n: th.contact_zero_n,
-            release_n: th.contact_force_n - th.contact_band_n,
-            limit_n: th.contact_force_n,
-        };
+        let levels = ContactLevels::of(&config.supervisor.thresholds);
         let force = config.skin.force.prepared();
-        let approach = ApproachBound::new(config.resolver.approach, levels, force, nv, model.nframes());
-        *resolver.closing_bounds_mut() = approach.limits(config.layout.num_cells());
+        let cells = config.layout.num_cells();
+        let approach = ApproachBound::new(config.resolver.approach, levels, force, nv, model.nframes(), cells);
+        *resolver.closing_bounds_mut() = approach.limits();
         let supervisor = Supervisor::new(&config.supervisor, t0_s)?;
         let output = ControllerOutput {
             commands: resolver.commands().clone(),

@@ -408,10 +408,11 @@ fn a_link_pushing_what_gives_way_pushes_faster_than_it_touches() {
     let config = ControllerConfig::load(&setup("planar7")).unwrap();
     let (model, layout, skin) = (&config.model, &config.layout, &config.skin);
     let (p, th) = (config.resolver.approach, config.supervisor.thresholds);
-    let release_n = th.contact_force_n - th.contact_band_n;
-    let levels = ContactLevels { zero_n: th.contact_zero_n, release_n, limit_n: th.contact_force_n };
-    let mut bound = ApproachBound::new(p, levels, skin.force.prepared(), model.nv(), model.nframes());
-    let mut limits = bound.limits(layout.num_cells());
+    let levels = ContactLevels::of(&th);
+    let release_n = levels.release_n;
+    let cells = layout.num_cells();
+    let mut bound = ApproachBound::new(p, levels, skin.force.prepared(), model.nv(), model.nframes(), cells);
+    let mut limits = bound.limits();
     let mut data = crate::model::ModelData::new(model);
     crate::model::update_kinematics(model, &mut data, &config.setup.posture, &vec![0.0; model.nv()]).unwrap();
     let pressed = 0;

@@ -142,7 +142,16 @@ const RATE_HZ: Range = Range::closed(1.0, 100_000.0);
 impl ResolverParams {
     /// Checks every section; the error's key is the dotted path in the file.
     pub fn validate(&self) -> Result<(), InvalidParam> {
-        self.check("")
+        self.check("")?;
+        let a = &self.approach;
+        if a.push_speed_max_mps < a.speed_min_mps {
+            return Err(InvalidParam {
+                key: "approach.push_speed_max_mps".into(),
+                value: a.push_speed_max_mps,
+                reason: "must be >= speed_min_mps (a push is never slower than a touch)".into(),
+            });
+        }
+        Ok(())
     }
 
     /// Parses and validates YAML text; `source` names the file in errors.

@@ -16,10 +16,10 @@ use crate::supervisor::Thresholds;
 pub(crate) enum ContactIntent {
     /// (b): push what gives way.
     Push,
-    /// (a), a hard contact a retry follows, and the interactive-force-control paper phases:
-    /// touch at most at the touch speed.
+    /// (a) and the interactive-force-control paper phases: touch at most at the touch speed.
     Touch,
-    /// A hard contact that ends the push ([`crate::supervisor::Supervisor::releasing`]): press nothing.
+    /// (c), whose reaction relieves the contact, and the hold after a push given up
+    /// ([`crate::supervisor::Supervisor::releasing`]): press nothing.
     Release,
 }
 
@@ -56,6 +56,8 @@ pub(crate) struct ApproachBound {
     push_mps: Vec<f64>,
     /// Scratch per model frame: the force on the link's cells this cycle \[N\].
     pressed_n: Vec<f64>,
+    /// Scratch per model frame: the largest force on one of the link's cells this cycle \[N\].
+    hardest_n: Vec<f64>,
     /// Scratch per live cell: its measured force this cycle \[N\] (0 below the threshold).
     forces_n: Vec<f64>,
     /// Scratch: one cell's row.
@@ -79,6 +81,7 @@ impl ApproachBound {
             force,
             push_mps: vec![params.speed_min_mps; nframes],
             pressed_n: vec![0.0; nframes],
+            hardest_n: vec![0.0; nframes],
             forces_n: Vec::with_capacity(cells),
             row: vec![0.0; nv],
         }
@@ -93,14 +96,17 @@ impl ApproachBound {
     /// Sets `bounds` to the limits for the cells' readings at the state of the last kinematics
     /// update, `dt_s` after the last: the outward normal's row (closing is positive) and
     /// `v_c + d / time` for distance `d`. The speed at contact `v_c` of a link's cells is
-    /// - 0 for a cell pressed at `ε_c` or more, and in a hard contact that ends the push
-    ///   ([`ContactIntent::Release`]): nothing drives the body back into a contact the reaction
-    ///   relieves (the goal below the reaction did, a limit cycle of touches for the rest of the run);
+    /// - 0 for a cell pressed at `ε_c` or more, and in a hard contact and the hold after a push
+    ///   given up ([`ContactIntent::Release`]): nothing drives the body back into a contact the
+    ///   reaction relieves (the goal below the reaction did, a limit cycle of touches for the rest
+    ///   of the run);
     /// - in a push ([`ContactIntent::Push`]), growing by `push_accel_mps2` up to
-    ///   `push_speed_max_mps` while the link is pressed between no contact and the release level
-    ///   of a hard contact: it pushes something that slides (a push at the touch speed would take
-    ///   10 s for 20 cm); falling back as fast when the pushed thing slid ahead out of contact,
-    ///   and at once to the touch speed when the link is pressed at that level;
+    ///   `push_speed_max_mps` while the link is in contact (its cells' forces sum above no
+    ///   contact) and none of its cells is pressed at the release level of a hard contact (the
+    ///   level is the supervisor's, of the largest cell force `‖F_c‖`): it pushes something that
+    ///   slides (a push at the touch speed would take 10 s for 20 cm); falling back as fast when
+    ///   the pushed thing slid ahead out of contact, and at once to the touch speed when a cell
+    ///   is pressed at that level;
     /// - otherwise the touch speed `speed_min_mps`.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn update(
@@ -120,18 +126,21 @@ impl ApproachBound {
         }
         let (p, levels) = (&self.params, self.levels);
         self.pressed_n.fill(0.0);
+        self.hardest_n.fill(0.0);
         self.forces_n.clear(); // within capacity: one per layout cell at most
         for (i, reading) in cells.cells() {
             let f = fusion.cell_force_n(reading, &self.force).unwrap_or(0.0);
-            self.pressed_n[layout.cells()[*i].frame] += f;
+            let frame = layout.cells()[*i].frame;
+            self.pressed_n[frame] += f;
+            self.hardest_n[frame] = self.hardest_n[frame].max(f);
             self.forces_n.push(f);
         }
         let dt = if dt_s.is_finite() { dt_s.max(0.0) } else { 0.0 };
         let (touch, fastest, dv) = (p.speed_min_mps, p.push_speed_max_mps, p.push_accel_mps2 * dt);
-        for (v, &f) in self.push_mps.iter_mut().zip(&self.pressed_n) {
+        for ((v, &f), &hardest) in self.push_mps.iter_mut().zip(&self.pressed_n).zip(&self.hardest_n) {
             *v = if intent != ContactIntent::Push {
                 touch
-            } else if f > levels.zero_n && f < levels.release_n {
+            } else if f > levels.zero_n && hardest < levels.release_n {
                 (*v + dv).min(fastest)
             } else if f <= levels.zero_n {
                 (*v - dv).max(touch) // a pushed object that slid ahead: the push goes on

@@ -397,10 +397,11 @@ fn no_skin_point_closes_on_a_sensed_surface_faster_than_the_approach_bound() {
 }
 
 /// The speed at contact of a link's cells (the limit at `d = 0`): the touch speed, growing by
-/// the push acceleration up to the fastest push while the link is pressed between no contact
-/// and the release level of a hard contact in a push (b); falling back as fast when the link is
-/// out of contact; back at the touch speed at once when it is pressed at that level and in any
-/// other arrangement; 0 for a cell at `ε_c` and when the contact is to be released.
+/// the push acceleration up to the fastest push while the link is in contact (its cells' forces
+/// sum above no contact) and none of its cells is pressed at the release level of a hard contact
+/// (the supervisor's `‖F_c‖`, the largest cell force) in a push (b); falling back as fast when
+/// the link is out of contact; back at the touch speed at once when a cell is pressed at that
+/// level and in any other arrangement; 0 for a cell at `ε_c` and when the contact is to be released.
 #[test]
 fn a_link_pushing_what_gives_way_pushes_faster_than_it_touches() {
     use super::approach::{ApproachBound, ContactIntent, ContactLevels};
@@ -417,19 +418,28 @@ fn a_link_pushing_what_gives_way_pushes_faster_than_it_touches() {
     crate::model::update_kinematics(model, &mut data, &config.setup.posture, &vec![0.0; model.nv()]).unwrap();
     let pressed = 0;
     let frame = layout.cells()[pressed].frame;
+    let on_link = (1..cells).find(|&i| layout.cells()[i].frame == frame).unwrap();
+    let elsewhere = (0..cells).find(|&i| layout.cells()[i].frame != frame).unwrap();
     let dt = 0.01;
-    // every cell touches a surface (d = 0), the first one pressed with `force_n`: the speeds at
-    // contact of the first cell, of another cell of its link and of a cell of another link
-    let mut step = |force_n: f64, intent: ContactIntent| {
-        let readings: Vec<CellReading> = (0..layout.num_cells())
-            .map(|i| CellReading::uniform(if i == pressed { skin.force.signal(force_n) } else { 0.0 }, 1.0))
+    // every cell touches a surface (d = 0), the first one pressed with `force_n` and another of
+    // its link with `beside_n`: the speeds at contact of these two and of a cell of another link
+    let mut step2 = |force_n: f64, beside_n: f64, intent: ContactIntent| {
+        let readings: Vec<CellReading> = (0..cells)
+            .map(|i| {
+                let f = if i == pressed {
+                    force_n
+                } else if i == on_link {
+                    beside_n
+                } else {
+                    0.0
+                };
+                CellReading::uniform(if f > 0.0 { skin.force.signal(f) } else { 0.0 }, 1.0)
+            })
             .collect();
         let live = LiveCells::from_readings(&readings, &skin.proximity);
         bound.update(model, &data, layout, &live, &skin.fusion, intent, dt, &mut limits).unwrap();
         let speeds: Vec<f64> = limits.iter().map(|(_, b)| b).collect();
-        assert_eq!(speeds.len(), layout.num_cells(), "every touching cell has a limit");
-        let on_link = (1..speeds.len()).find(|&i| layout.cells()[i].frame == frame).unwrap();
-        let elsewhere = (0..speeds.len()).find(|&i| layout.cells()[i].frame != frame).unwrap();
+        assert_eq!(speeds.len(), cells, "every touching cell has a limit");
         (speeds[pressed], speeds[on_link], speeds[elsewhere])
     };
     let (touch, fastest, a) = (p.speed_min_mps, p.push_speed_max_mps, p.push_accel_mps2);
@@ -437,15 +447,19 @@ fn a_link_pushing_what_gives_way_pushes_faster_than_it_touches() {
     assert!(touch + 10.0 * a * dt < fastest, "the ramp is seen before it saturates");
     let mut last = (0.0, 0.0, 0.0);
     for k in 1..=10 {
-        last = step(push_n, ContactIntent::Push);
+        last = step2(push_n, 0.0, ContactIntent::Push);
         let v = touch + k as f64 * a * dt;
         assert!((last.0 - v).abs() < 1e-9 && (last.1 - v).abs() < 1e-9, "step {k}: {last:?}, expected {v}");
         assert_eq!(last.2, touch, "another link touches");
     }
+    let spread = 0.9 * release_n;
+    let v = step2(spread, spread, ContactIntent::Push).0;
+    assert!(v > last.0, "two cells under the release level, their sum over it: still a push ({v})");
     for _ in 0..((fastest / (a * dt)) as usize) {
-        last = step(push_n, ContactIntent::Push);
+        last = step2(push_n, 0.0, ContactIntent::Push);
     }
     assert_eq!(last.0, fastest, "the fastest push");
+    let mut step = |force_n: f64, intent: ContactIntent| step2(force_n, 0.0, intent);
     assert!((step(0.0, ContactIntent::Push).0 - (fastest - a * dt)).abs() < 1e-9, "out of contact: falls back");
     assert_eq!(step(release_n + 0.1, ContactIntent::Push).0, touch, "at the release level: the touch");
     step(push_n, ContactIntent::Push);

@@ -40,8 +40,9 @@ declare_params! {
         pub speed_min_mps: f64 => { unit: "m/s", range: Range::positive(10.0), live: false },
         /// Time in which the allowed closing speed would cover the sensed distance.
         pub time_s: f64 => { unit: "s", range: Range::positive(100.0), live: false },
-        /// A link in contact below the release level of a hard contact pushes something that
-        /// gives way: its speed at contact grows from `speed_min_mps` by this much per second.
+        /// A link in contact with none of its cells at the release level of a hard contact
+        /// pushes something that gives way: its speed at contact grows from `speed_min_mps` by
+        /// this much per second.
         #[serde(default = "default_push_accel")]
         pub push_accel_mps2: f64 => { unit: "m/s²", range: Range::closed(0.0, 100.0), live: false },
         /// The fastest push into a surface that gives way.

@@ -281,13 +281,18 @@ impl Supervisor {
         self.blocked
     }
 
-    /// In a hard contact (c) that no push follows (entered from (a), or from (b) without a
-    /// retry): the contact is to be relieved, not pressed again (the skin's approach bound lets
-    /// nothing close on a sensed surface then, `docs/resolver.md`). A follower ([`Self::impose`])
-    /// has the deciding supervisor's.
+    /// A push has ended: in a hard contact (c) that no push follows (entered from (a), or from
+    /// (b) without a retry), and in the [`Blocked`] hold after it. The contact is to be relieved
+    /// and not pressed again (the skin's approach bound lets nothing close on a sensed surface
+    /// then, `docs/resolver.md`); in the hold the goal would drive the arm back into the obstacle
+    /// that blocked it, at the touch speed, and into ε_c again. A follower ([`Self::impose`]) has
+    /// the deciding supervisor's.
     pub fn releasing(&self) -> bool {
-        let own = !(self.resume == Mode::IntentionalContact && self.retry);
-        self.arrangement.mode == Mode::HardContact && if self.follower { self.imposed_releasing } else { own }
+        if self.follower {
+            return self.imposed_releasing;
+        }
+        let ended = !(self.resume == Mode::IntentionalContact && self.retry);
+        (self.arrangement.mode == Mode::HardContact && ended) || self.blocked.is_some()
     }
 
     /// The goal changed: a push that was given up may succeed toward the new goal, so the

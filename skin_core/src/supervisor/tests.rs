@@ -163,6 +163,7 @@ fn a_push_that_made_progress_is_retried_once_per_interval() {
     assert!(sup.releasing(), "a push given up is released, not pressed again");
     let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
     assert_eq!(tr.last().map(|tr| tr.cause), Some(Cause::PushBlocked));
+    assert!(sup.releasing(), "the hold after a push given up presses nothing either");
 
     // No progress since the push began: blocked on the first hard contact.
     let (mut sup, mut t) = in_b(&p);

@@ -28,8 +28,8 @@ pub struct CycleRecord {
     /// (`skin_core::supervisor::Blocked`); always false when the controller ran elsewhere
     /// (`ControllerState.msg` does not carry it yet).
     pub blocked: bool,
-    /// In a hard contact (c) that is to be relieved, not pressed again
-    /// (`skin_core::supervisor::Supervisor::releasing`); always false when the controller ran
+    /// A push has ended: in a hard contact (c) that is to be relieved, not pressed again, and in
+    /// the blocked hold after it (`skin_core::supervisor::Supervisor::releasing`); always false when the controller ran
     /// elsewhere (`ControllerState.msg` does not carry it).
     pub releasing: bool,
     /// `χ` of intentional-contact paper eq. (10)-(11), 0 outside a blend.

@@ -62,7 +62,7 @@ fn default_push_speed_max() -> f64 {
 impl Default for ApproachParams {
     /// The shipped values (`config/resolver.yaml`).
     fn default() -> Self {
-        Self { enabled: true, speed_min_mps: 0.02, time_s: 0.5, push_accel_mps2: 0.1, push_speed_max_mps: 0.06 }
+        Self { enabled: true, speed_min_mps: 0.02, time_s: 0.5, push_accel_mps2: 0.1, push_speed_max_mps: 0.1 }
     }
 }
 

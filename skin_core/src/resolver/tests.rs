@@ -43,7 +43,7 @@ fn resolver_invalid_param_names_file_and_key() {
     let bad = text.replace("rate_hz: 125.0", "rate_hz: 125.0\n  bogus: 1");
     let e = ResolverParams::from_yaml_str(&bad, "c.yaml").unwrap_err().to_string();
     assert!(e.starts_with("c.yaml:") && e.contains("bogus"), "{e}");
-    let bad = text.replace("push_speed_max_mps: 0.06", "push_speed_max_mps: 0.01");
+    let bad = text.replace("push_speed_max_mps: 0.1 ", "push_speed_max_mps: 0.01 ");
     assert_ne!(bad, text);
     let e = ResolverParams::from_yaml_str(&bad, "d.yaml").unwrap_err().to_string();
     assert!(e.contains("d.yaml") && e.contains("approach.push_speed_max_mps"), "{e}");

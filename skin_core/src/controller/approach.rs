@@ -18,8 +18,8 @@ pub(crate) enum ContactIntent {
     Push,
     /// (a) and the interactive-force-control paper phases: touch at most at the touch speed.
     Touch,
-    /// (c), whose reaction relieves the contact, and the hold after a push given up
-    /// ([`crate::supervisor::Supervisor::releasing`]): press nothing.
+    /// (c) and the hold after a push given up ([`crate::supervisor::Supervisor::releasing`]):
+    /// press nothing.
     Release,
 }
 

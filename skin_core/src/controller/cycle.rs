@@ -496,9 +496,6 @@ impl Controller {
 
         // 5. admittance resolver, within the skin's approach bound
         let intent = match self.supervisor.mode() {
-            // Table I (c) relieves the contact, a retried push too: its goal pressed the link back
-            // into a fixed obstacle at the touch speed for the rest of the run (`docs/resolver.md`)
-            Mode::HardContact => ContactIntent::Release,
             _ if self.output.releasing => ContactIntent::Release,
             Mode::IntentionalContact => ContactIntent::Push,
             _ => ContactIntent::Touch,

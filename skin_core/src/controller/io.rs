@@ -73,8 +73,8 @@ pub struct ControllerOutput {
     /// Why the arm holds in (a) instead of pushing again: a push in intentional contact reached
     /// `ε_c` (`None`: not blocked). `ControllerState.msg` does not carry it yet.
     pub blocked: Option<Blocked>,
-    /// A push has ended: in a hard contact (c) that is to be relieved, not pressed again, and in
-    /// the blocked hold after it ([`crate::supervisor::Supervisor::releasing`]).
+    /// Nothing is to be pressed: in a hard contact (c) and in the blocked hold after a push given
+    /// up ([`crate::supervisor::Supervisor::releasing`]).
     pub releasing: bool,
     /// `χ` of intentional-contact paper eq. (10)-(11): the weight of the previous arrangement's torque (0: no
     /// blend in progress).

@@ -281,18 +281,17 @@ impl Supervisor {
         self.blocked
     }
 
-    /// A push has ended: in a hard contact (c) that no push follows (entered from (a), or from
-    /// (b) without a retry), and in the [`Blocked`] hold after it. The contact is to be relieved
-    /// and not pressed again (the skin's approach bound lets nothing close on a sensed surface
-    /// then, `docs/resolver.md`); in the hold the goal would drive the arm back into the obstacle
-    /// that blocked it, at the touch speed, and into ε_c again. A follower ([`Self::impose`]) has
-    /// the deciding supervisor's.
+    /// Nothing is to be pressed: in a hard contact (c), whose reaction relieves the contact (a
+    /// retried push goes on in (b) once it is relieved; its goal pressing on in (c) held a fixed
+    /// obstacle there to the end of the run), and in the [`Blocked`] hold after a push given up,
+    /// where the goal would drive the arm back into the obstacle that blocked it and into ε_c
+    /// again. The skin's approach bound then lets nothing close on a sensed surface
+    /// (`docs/resolver.md`). A follower ([`Self::impose`]) has the deciding supervisor's.
     pub fn releasing(&self) -> bool {
         if self.follower {
             return self.imposed_releasing;
         }
-        let ended = !(self.resume == Mode::IntentionalContact && self.retry);
-        (self.arrangement.mode == Mode::HardContact && ended) || self.blocked.is_some()
+        self.arrangement.mode == Mode::HardContact || self.blocked.is_some()
     }
 
     /// The goal changed: a push that was given up may succeed toward the new goal, so the

@@ -28,8 +28,8 @@ pub struct CycleRecord {
     /// (`skin_core::supervisor::Blocked`); always false when the controller ran elsewhere
     /// (`ControllerState.msg` does not carry it yet).
     pub blocked: bool,
-    /// A push has ended: in a hard contact (c) that is to be relieved, not pressed again, and in
-    /// the blocked hold after it (`skin_core::supervisor::Supervisor::releasing`); always false when the controller ran
+    /// Nothing is to be pressed: in a hard contact (c) and in the blocked hold after a push given
+    /// up (`skin_core::supervisor::Supervisor::releasing`); always false when the controller ran
     /// elsewhere (`ControllerState.msg` does not carry it).
     pub releasing: bool,
     /// `χ` of intentional-contact paper eq. (10)-(11), 0 outside a blend.

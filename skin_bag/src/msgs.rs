@@ -307,7 +307,7 @@ pub struct Arrangement {
     pub sensing_range: f64,
     /// Fusion weight, \[0, 1\].
     pub fusion_weight: f64,
-    /// In a hard contact: to be relieved, not pressed again.
+    /// Nothing is to be pressed: in a hard contact and in the blocked hold after a push given up.
     pub releasing: bool,
 }
 

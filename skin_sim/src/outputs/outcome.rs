@@ -42,10 +42,10 @@ pub const FIRST_CONTACT_OVERSHOOT_N: f64 = 2.0;
 
 /// The checks of a run. Every run: safe ([`safety::violations`]). What the scene declares
 /// (`expect`; `None`: a scene with goals expects the supervisor's goal tolerance and `ε_c`):
-/// the goal reached (and before the first push on an object, when there is one), every contact at most `ε_c` outside the pushes and the pushes relieved
-/// within [`RECOVERY_LIMIT_S`], a peak contact force, the RMS force errors of Table 3; with
-/// `safety`, a run that ends `blocked` (the push could not succeed) passes on safety and the
-/// peak alone. Every scene of its kind:
+/// the goal reached (and before the first push on an object, when there is one), every contact
+/// at most `ε_c` outside the pushes and the pushes relieved within [`RECOVERY_LIMIT_S`], a peak
+/// contact force, the RMS force errors of Table 3; with `safety`, a run that ends `blocked` (the
+/// push could not succeed) passes on safety and the peak alone. Every scene of its kind:
 /// force scenes the first touch, the rise and a finite from-touch RMS; scenes with neither goals
 /// nor force references (interactive-force-control paper Exp. 2) no link contact above `ε_c`,
 /// the hand at `d_p,d` (when it is not 0) and moved by the touches on the arm (when there are

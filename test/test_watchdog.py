@@ -67,7 +67,14 @@ def test_watchdog_zeroes_every_command_topic_when_the_controller_dies(spawn, rcl
                "the restarted controller moving the arm")
     spin_until(rclpy_node, lambda: len(got["right"]) > k0["right"] + 300, 60.0, "more commands")
     back = min(b for b in beats if b > killed)  # the restarted controller's first heartbeat
+    # A heartbeat late by more than the timeout trips the watchdog while the controller runs (a
+    # loaded host, above): its zeros go out at once, by design, within a period of the announced
+    # trip; the controller then starts from zero again, which the steps after them check.
+    stamps = [tr.stamp.sec + tr.stamp.nanosec * 1e-9 for tr in trips]
+    late = [s for s in stamps if s > back]
+    tripped = lambda m: all(v == 0.0 for v in m[1]) and any(abs(m[0] - s) <= PERIOD for s in late)  # noqa: E731
+    print(f"trips after the restart: {[round(s - back, 3) for s in late]} s after its first heartbeat")
     for k in ("left", "right"):
         ramp = [m for m in got[k] if m[0] > back - 2 * PERIOD][:60]  # the last zeros, then 0.4 s of ramp
-        assert arm_steps_ok(ramp), f"{k}: from zero within the acceleration limits"
+        assert arm_steps_ok(ramp, tripped), f"{k}: from zero within the acceleration limits"
     assert dog.poll() is None

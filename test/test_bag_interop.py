@@ -74,10 +74,15 @@ def expected(ts):
         ("/supervisor/arrangement", 9 * S, T["skin_msgs/msg/Arrangement"](
             mode=1, task_order=["goal", "contact_reaction", "avoidance"],
             switch_time=Time(sec=8, nanosec=500_000_000), smoothing_gain=5.0, sensing_range=0.05,
-            fusion_weight=0.75, releasing=True)),
+            fusion_weight=0.75, releasing=True, blocked=T["skin_msgs/msg/BlockedHold"](
+                active=True, since=Time(sec=7, nanosec=125_000_000), goal_error=0.25,
+                contact_force=5.5))),
         ("/controller/state", 10 * S, T["skin_msgs/msg/ControllerState"](
             header=header(10, ""), mode=2, blend=0.3, ee_speed=0.012, avoidance_force=1.5,
-            contact_force=12.5, torque_norm=42.0, goal_error=-1.0, tasks=[
+            contact_force=12.5, torque_norm=42.0, goal_error=-1.0, releasing=True,
+            blocked=T["skin_msgs/msg/BlockedHold"](
+                active=False, since=Time(sec=0, nanosec=0), goal_error=0.0, contact_force=0.0),
+            goal_count=3, tasks=[
                 task(name="contact_reaction", priority=1, error_norm=2.5, torque_norm=30.0),
                 task(name="goal", priority=2, error_norm=0.2, torque_norm=12.0)],
             input_status=2, safe_stop_cycles=3, idle_periods=40,

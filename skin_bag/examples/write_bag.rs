@@ -143,6 +143,12 @@ fn samples(v: &mut impl Visit) -> Result<()> {
             sensing_range: 0.05,
             fusion_weight: 0.75,
             releasing: true,
+            blocked: BlockedHold {
+                active: true,
+                since: Time { sec: 7, nanosec: 125_000_000 },
+                goal_error: 0.25,
+                contact_force: 5.5,
+            },
         },
     )?;
     v.visit(
@@ -157,6 +163,9 @@ fn samples(v: &mut impl Visit) -> Result<()> {
             contact_force: 12.5,
             torque_norm: 42.0,
             goal_error: -1.0,
+            releasing: true,
+            blocked: BlockedHold { active: false, since: Time::default(), goal_error: 0.0, contact_force: 0.0 },
+            goal_count: 3,
             tasks: vec![
                 TaskState { name: "contact_reaction".into(), priority: 1, error_norm: 2.5, torque_norm: 30.0 },
                 TaskState { name: "goal".into(), priority: 2, error_norm: 0.2, torque_norm: 12.0 },

@@ -48,6 +48,7 @@ const DEFINITIONS: &[(&str, &str)] = &[
     std_msg!("sensor_msgs", "LaserScan"),
     std_msg!("nav_msgs", "Odometry"),
     skin_msg!("Arrangement"),
+    skin_msg!("BlockedHold"),
     skin_msg!("ControllerState"),
     skin_msg!("PatchWrench"),
     skin_msg!("PatchWrenchArray"),
@@ -133,9 +134,10 @@ mod tests {
         for dep in ["skin_msgs/PatchWrench", "geometry_msgs/Wrench", "geometry_msgs/Point"] {
             assert!(full.contains(&format!("MSG: {dep}\n")), "{dep} missing");
         }
-        // Constants are primitives, not dependencies.
+        // Constants are primitives, not dependencies; Time is written once though used twice.
         let arrangement = full_definition("skin_msgs/msg/Arrangement").unwrap();
-        assert_eq!(arrangement.matches("MSG: ").count(), 1);
+        assert_eq!(arrangement.matches("MSG: ").count(), 2);
+        assert!(arrangement.contains("MSG: skin_msgs/BlockedHold\n"));
     }
 
     #[test]

@@ -309,6 +309,21 @@ pub struct Arrangement {
     pub fusion_weight: f64,
     /// Nothing is to be pressed: in a hard contact and in the blocked hold after a push given up.
     pub releasing: bool,
+    /// The blocked hold.
+    pub blocked: BlockedHold,
+}
+
+/// `skin_msgs/BlockedHold`: why the arm holds in (a) after a push that reached `ε_c`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct BlockedHold {
+    /// Blocked.
+    pub active: bool,
+    /// When the push was given up.
+    pub since: Time,
+    /// The goal error then \[m\].
+    pub goal_error: f64,
+    /// The largest contact force of the hard contact that blocked the push \[N\].
+    pub contact_force: f64,
 }
 
 /// `skin_msgs/TaskState`.
@@ -343,6 +358,12 @@ pub struct ControllerState {
     pub torque_norm: f64,
     /// Distance to the goal \[m\], negative without goal.
     pub goal_error: f64,
+    /// Nothing is to be pressed.
+    pub releasing: bool,
+    /// The blocked hold.
+    pub blocked: BlockedHold,
+    /// Goals set since start.
+    pub goal_count: u32,
     /// Per-task state.
     pub tasks: Vec<TaskState>,
     /// Input health: 0 fresh, 1 waiting, 2 stale (docs/reliability.md).

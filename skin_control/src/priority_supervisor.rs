@@ -1,6 +1,7 @@
 //! The priority supervisor's work without the node around it: `/controller/state` in,
 //! `skin_core::supervisor::Supervisor` updated on the state's stamp, `/supervisor/arrangement`
-//! out when it changed; phase requests from `/supervisor/set_phase`.
+//! out when it changed; phase requests from `/supervisor/set_phase`; a new goal (the state's
+//! `goal_count` changed) ends a blocked hold.
 use r2r::skin_msgs::msg::{Arrangement as ArrangementMsg, ControllerState};
 use skin_core::supervisor::{Phase, Supervisor, SupervisorParams};
 
@@ -17,6 +18,7 @@ pub struct PrioritySupervisor {
     sup: Supervisor,
     last: Option<ArrangementMsg>,
     updates: u64,
+    goal_count: Option<u32>,
 }
 
 impl PrioritySupervisor {
@@ -26,6 +28,7 @@ impl PrioritySupervisor {
             sup: Supervisor::new(params, t0_s).map_err(|e| e.to_string())?,
             last: None,
             updates: 0,
+            goal_count: None,
         })
     }
 
@@ -41,7 +44,7 @@ impl PrioritySupervisor {
 
     /// The active arrangement as a message.
     pub fn current(&self) -> ArrangementMsg {
-        arrangement_msg(self.sup.arrangement(), self.sup.tasks(), self.sup.releasing())
+        arrangement_msg(self.sup.arrangement(), self.sup.tasks(), self.sup.releasing(), self.sup.blocked())
     }
 
     /// Takes one controller state; returns the arrangement to publish when it differs from the
@@ -51,6 +54,9 @@ impl PrioritySupervisor {
     pub fn on_state(&mut self, msg: &ControllerState) -> Option<ArrangementMsg> {
         if msg.input_status != ControllerState::INPUT_FRESH as u8 {
             return None;
+        }
+        if self.goal_count.replace(msg.goal_count).is_some_and(|c| c != msg.goal_count) {
+            self.sup.new_goal(); // as the controller's own supervisor does in `set_goal`
         }
         let (t, input) = supervisor_input(msg);
         self.sup.update(t, &input);
@@ -122,6 +128,35 @@ mod tests {
         assert!(!ok && why.contains("intentional_contact policy"), "{why}");
         let (ok, why) = s.request_phase(7);
         assert!(!ok && why.contains("phase = 7"), "{why}");
+    }
+
+    /// A push that reached ε_c holds the arm blocked, announced in the arrangement with its
+    /// reason; the hold ends when the controller reports a new goal (its `goal_count`), as it
+    /// ends in the controller's own supervisor.
+    #[test]
+    fn a_blocked_hold_is_published_and_ended_by_a_new_goal() {
+        let mut s = PrioritySupervisor::new(&params("intentional_contact"), 0.0).unwrap();
+        let mut t = 0.0;
+        let mut last = None;
+        let mut feed = |s: &mut PrioritySupervisor, steps: usize, fc: f64, goals: u32| {
+            for _ in 0..steps {
+                t += 0.004;
+                let msg = ControllerState { goal_count: goals, ..state(t, 0.0, 3.0, fc, 0.2) };
+                last = s.on_state(&msg).or(last.take());
+            }
+            last.clone().unwrap()
+        };
+        assert_eq!(feed(&mut s, 1000, 0.0, 7).mode, 1, "stuck at an obstacle: (b)");
+        assert_eq!(feed(&mut s, 10, 20.0, 7).mode, 2, "the push reached eps_c: (c)");
+        let held = feed(&mut s, 500, 0.0, 7);
+        assert_eq!(held.mode, 0);
+        assert!(held.releasing && held.blocked.active, "{held:?}");
+        assert_eq!((held.blocked.goal_error, held.blocked.contact_force), (0.2, 20.0));
+        let held = feed(&mut s, 2500, 0.0, 7);
+        assert!(held.blocked.active && held.mode == 0, "10 s still stuck: held, no second push");
+        let freed = feed(&mut s, 1, 0.0, 8);
+        assert!(!freed.blocked.active && !freed.releasing, "a new goal ends the hold: {freed:?}");
+        assert_eq!(feed(&mut s, 1000, 0.0, 8).mode, 1, "and the arm may push toward it");
     }
 
     #[test]

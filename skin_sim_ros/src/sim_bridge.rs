@@ -21,7 +21,9 @@ use skin_sim::run::runner::Decision;
 use skin_sim::scene::Scene;
 use skin_sim::world::World;
 
-use skin_control::convert::control::{read_arm_command, split_arms, supervisor_input, twist_of, ArmCommand};
+use skin_control::convert::control::{
+    blocked_of, read_arm_command, split_arms, supervisor_input, twist_of, ArmCommand,
+};
 use skin_control::convert::robot::{time_msg, write_goal, write_joint_state, write_odometry, BaseState};
 use skin_control::convert::write_cell_array;
 use skin_control::tf::{BASE_FRAME, ODOM_FRAME, WORLD_FRAME};
@@ -74,6 +76,8 @@ pub fn decision(
         joint_velocities: applied.joints.clone(),
         base_twist: applied.base,
         mode,
+        blocked: blocked_of(&state.blocked),
+        releasing: state.releasing,
         blend: state.blend,
         fusion_weight,
         signals: supervisor_input(state).1,

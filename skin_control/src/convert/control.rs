@@ -9,11 +9,11 @@
 //! (shoulder_pan, shoulder_lift, elbow, wrist_1..3). Every arm joint must fall into exactly one arm.
 use r2r::builtin_interfaces::msg::Time;
 use r2r::geometry_msgs::msg::Twist;
-use r2r::skin_msgs::msg::{Arrangement as ArrangementMsg, ControllerState, TaskState};
+use r2r::skin_msgs::msg::{Arrangement as ArrangementMsg, BlockedHold, ControllerState, TaskState};
 use r2r::std_msgs::msg::{Float64MultiArray, MultiArrayDimension};
 use skin_core::controller::ControllerOutput;
 use skin_core::hierarchy::LevelDiagnostics;
-use skin_core::supervisor::{Arrangement, Imposed, Mode};
+use skin_core::supervisor::{Arrangement, Blocked, Imposed, Mode};
 
 use super::robot::{time_msg, time_s};
 
@@ -147,6 +147,9 @@ pub fn write_controller_state(
     msg.torque_norm = out.torque_norm;
     let ge = out.signals.goal_error_m;
     msg.goal_error = if ge.is_nan() { -1.0 } else { ge };
+    msg.releasing = out.releasing;
+    msg.blocked = blocked_hold_msg(out.blocked);
+    msg.goal_count = out.goal_count;
     msg.tasks.resize_with(tasks.len(), TaskState::default);
     for (state, name) in msg.tasks.iter_mut().zip(tasks) {
         if state.name != *name {
@@ -183,9 +186,29 @@ pub fn supervisor_input(msg: &ControllerState) -> (f64, skin_core::supervisor::S
     )
 }
 
-/// The message of an arrangement (`tasks`: the configured task names; `releasing`:
-/// [`skin_core::supervisor::Supervisor::releasing`]).
-pub fn arrangement_msg(a: &Arrangement, tasks: &[String], releasing: bool) -> ArrangementMsg {
+/// The blocked hold as a message (inactive and zero: not blocked).
+pub fn blocked_hold_msg(b: Option<Blocked>) -> BlockedHold {
+    b.map_or_else(BlockedHold::default, |b| BlockedHold {
+        active: true,
+        since: time_msg(b.since_s),
+        goal_error: b.goal_error_m,
+        contact_force: b.contact_force_n,
+    })
+}
+
+/// The blocked hold of a message (`None`: inactive). Its values are reported, never decided
+/// on, so NaN (a NaN contact force ends a push as over `ε_c`) passes through.
+pub fn blocked_of(msg: &BlockedHold) -> Option<Blocked> {
+    msg.active.then(|| Blocked {
+        since_s: time_s(&msg.since),
+        goal_error_m: msg.goal_error,
+        contact_force_n: msg.contact_force,
+    })
+}
+
+/// The message of an arrangement (`tasks`: the configured task names; `releasing` and
+/// `blocked`: [`skin_core::supervisor::Supervisor::releasing`] and `blocked`).
+pub fn arrangement_msg(a: &Arrangement, tasks: &[String], releasing: bool, blocked: Option<Blocked>) -> ArrangementMsg {
     ArrangementMsg {
         mode: a.mode.as_u8(),
         task_order: a.task_names(tasks).map(str::to_string).collect(),
@@ -194,6 +217,7 @@ pub fn arrangement_msg(a: &Arrangement, tasks: &[String], releasing: bool) -> Ar
         sensing_range: a.sensing_range_m,
         fusion_weight: a.fusion_weight_target,
         releasing,
+        blocked: blocked_hold_msg(blocked),
     }
 }
 
@@ -225,6 +249,7 @@ pub fn imposed_of(msg: &ArrangementMsg, configured: impl Fn(Mode) -> Vec<String>
         sensing_range_m: msg.sensing_range,
         fusion_weight_target: msg.fusion_weight,
         releasing: msg.releasing,
+        blocked: blocked_of(&msg.blocked),
     })
 }
 
@@ -275,6 +300,7 @@ mod tests {
             sensing_range: 0.05,
             fusion_weight: 0.5,
             releasing: true,
+            blocked: blocked_hold_msg(Some(Blocked { since_s: 2.5, goal_error_m: 0.2, contact_force_n: f64::NAN })),
         };
         let cfg = |m: Mode| {
             if m == Mode::IntentionalContact {
@@ -286,6 +312,11 @@ mod tests {
         let a = imposed_of(&msg, cfg).unwrap();
         assert_eq!((a.mode, a.switch_time_s, a.sensing_range_m), (Mode::IntentionalContact, 2.5, 0.05));
         assert!(a.releasing);
+        let b = a.blocked.expect("blocked");
+        assert_eq!((b.since_s, b.goal_error_m), (2.5, 0.2));
+        assert!(b.contact_force_n.is_nan());
+        assert_eq!(blocked_hold_msg(None), BlockedHold::default());
+        assert_eq!(blocked_of(&BlockedHold::default()), None);
         let bad = ArrangementMsg { mode: 9, ..msg.clone() };
         assert_eq!(imposed_of(&bad, cfg).unwrap_err(), "mode = 9: not an Arrangement.MODE_* constant");
         let bad = ArrangementMsg { mode: 0, ..msg };

@@ -803,8 +803,8 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
     })?;
     let arrangement = node.subscribe::<Arrangement>(local(ARRANGEMENT), qos::latched())?;
     spawn_sub(spawner, arrangement, &shared, |s, msg| match s.tc.on_arrangement(&msg) {
-        Ok(true) => r2r::log_info!(&s.logger, "{ARRANGEMENT}: following mode {} {:?}", msg.mode, msg.task_order),
-        Ok(false) => {}
+        Ok(Some(note)) => r2r::log_info!(&s.logger, "{ARRANGEMENT}: {note}"),
+        Ok(None) => {}
         Err(e) => s.refused(Err(e)),
     })?;
 

@@ -361,6 +361,8 @@ pub struct TaskController {
     arm_msgs: Vec<Float64MultiArray>,
     twist: Twist,
     state_msg: ControllerState,
+    /// Mode, switch time and blocked hold of the last arrangement followed (for the log).
+    followed: Option<(Mode, f64, bool)>,
     cycles: u64,
     faults: u64,
     health: Health,
@@ -399,6 +401,7 @@ impl TaskController {
                 .collect(),
             twist: Twist::default(),
             state_msg: ControllerState::default(),
+            followed: None,
             state,
             scan,
             no_scan: Vec::new(),
@@ -604,11 +607,12 @@ impl TaskController {
             .map_err(|f| self.health.refuse(FORCE_REFERENCE)(f.to_string()))
     }
 
-    /// `/supervisor/arrangement` (ignored with `supervisor: internal`; returns whether it was
-    /// applied).
-    pub fn on_arrangement(&mut self, msg: &ArrangementMsg) -> Result<bool, InputError> {
+    /// `/supervisor/arrangement` (ignored with `supervisor: internal`). Returns what a log should
+    /// say: a switch, or a blocked hold beginning or ending (not the sensing-range steps, which
+    /// republish the arrangement every cycle of a ramp).
+    pub fn on_arrangement(&mut self, msg: &ArrangementMsg) -> Result<Option<String>, InputError> {
         if self.params.supervisor == SupervisorSource::Internal {
-            return Ok(false);
+            return Ok(None);
         }
         let configured = |mode: Mode| -> Vec<String> {
             let params = &self.controller.config().supervisor;
@@ -617,7 +621,22 @@ impl TaskController {
         };
         let imposed = imposed_of(msg, configured).map_err(self.health.refuse(ARRANGEMENT))?;
         self.controller.impose_arrangement(imposed).map_err(|e| self.health.refuse(ARRANGEMENT)(e.to_string()))?;
-        Ok(true)
+        let now = (imposed.mode, imposed.switch_time_s, imposed.blocked.is_some());
+        let before = self.followed.replace(now);
+        let mut notes = Vec::new();
+        if before.map(|(m, t, _)| (m, t)) != Some((now.0, now.1)) {
+            notes.push(format!("following mode {} {:?}", msg.mode, msg.task_order));
+        }
+        match (before.is_some_and(|b| b.2), imposed.blocked) {
+            (false, Some(b)) => notes.push(format!(
+                "blocked: the push was given up at t = {:.3} s ({:.2} N against eps_c, the goal {:.3} m away); \
+                 holding until a new goal, goal progress or nothing in range",
+                b.since_s, b.contact_force_n, b.goal_error_m
+            )),
+            (true, None) => notes.push("the blocked hold ended".to_string()),
+            _ => {}
+        }
+        Ok((!notes.is_empty()).then(|| notes.join("; ")))
     }
 
     /// The required inputs that have not arrived yet (empty: complete).

@@ -391,3 +391,26 @@ fn parameter_table_in_docs_is_current() {
         assert_eq!(&doc[a..b], table, "docs/ros.md is stale: SKIN_BLESS=1 cargo test -p skin_control parameter_table");
     }
 }
+
+/// A follower logs a switch and the start and end of a blocked hold, with its reason, but not
+/// the sensing-range steps that republish the arrangement every cycle of a ramp.
+#[test]
+fn a_follower_logs_switches_and_the_blocked_hold_not_range_steps() {
+    use crate::convert::control::{arrangement_msg, blocked_hold_msg};
+    use skin_core::supervisor::{Blocked, Supervisor};
+    let config = ControllerConfig::load(&paths::resolve("config/controller/planar7.yaml").unwrap()).unwrap();
+    let sup = Supervisor::new(&config.supervisor, 0.0).unwrap();
+    let mut tc = TaskController::new(config.clone(), TaskControllerParams::defaults(&config), 0.0).unwrap();
+    let mut msg = arrangement_msg(sup.arrangement(), sup.tasks(), false, None);
+    let note = tc.on_arrangement(&msg).unwrap().expect("the first arrangement");
+    assert!(note.starts_with("following mode 0"), "{note}");
+    msg.sensing_range *= 0.5;
+    assert_eq!(tc.on_arrangement(&msg).unwrap(), None, "a range step is no news");
+    msg.releasing = true;
+    msg.blocked = blocked_hold_msg(Some(Blocked { since_s: 11.0, goal_error_m: 0.17, contact_force_n: 7.35 }));
+    let note = tc.on_arrangement(&msg).unwrap().expect("the hold");
+    assert!(note.starts_with("blocked: the push was given up at t = 11.000 s (7.35 N"), "{note}");
+    assert_eq!(tc.on_arrangement(&msg).unwrap(), None);
+    msg.blocked.active = false;
+    assert_eq!(tc.on_arrangement(&msg).unwrap().as_deref(), Some("the blocked hold ended"));
+}

@@ -158,6 +158,7 @@ impl Controller {
             fault: None,
             mode: supervisor.mode(),
             blocked: None,
+            goal_count: 0,
             releasing: false,
             blend: 0.0,
             fusion_weight: config.skin.fusion.weight_force,
@@ -221,6 +222,7 @@ impl Controller {
         }
         if goal != self.goal {
             self.supervisor.new_goal(); // a push given up toward the old goal may succeed now
+            self.output.goal_count = self.output.goal_count.wrapping_add(1);
         }
         self.goal = goal;
         Ok(())

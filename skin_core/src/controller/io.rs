@@ -71,8 +71,11 @@ pub struct ControllerOutput {
     /// The active arrangement's mode.
     pub mode: Mode,
     /// Why the arm holds in (a) instead of pushing again: a push in intentional contact reached
-    /// `ε_c` (`None`: not blocked). `ControllerState.msg` does not carry it yet.
+    /// `ε_c` (`None`: not blocked); `ControllerState.blocked`.
     pub blocked: Option<Blocked>,
+    /// Goals set since start ([`crate::controller::Controller::set_goal`] with a changed goal): a
+    /// change tells a deciding supervisor of a new goal, which ends its [`Blocked`] hold.
+    pub goal_count: u32,
     /// Nothing is to be pressed: in a hard contact (c) and in the blocked hold after a push given
     /// up ([`crate::supervisor::Supervisor::releasing`]).
     pub releasing: bool,

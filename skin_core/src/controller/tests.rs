@@ -115,6 +115,12 @@ fn bad_inputs_make_safe_stop_steps() {
     }
     assert!(c.set_goal(Some(Isometry3::translation(f64::NAN, 0.0, 0.0))).is_err());
     assert!(c.set_hand_force_reference(f64::NAN).is_err());
+    // Only a changed goal counts as new (a priority supervisor elsewhere ends its blocked hold on it).
+    assert_eq!(c.output().goal_count, 1, "the goal set once; the refused one does not count");
+    c.set_goal(Some(Isometry3::translation(0.0, 1.2, 0.0))).unwrap();
+    assert_eq!(c.output().goal_count, 1, "the same goal again");
+    c.set_goal(None).unwrap();
+    assert_eq!(c.output().goal_count, 2);
 }
 
 #[test]

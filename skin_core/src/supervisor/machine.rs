@@ -254,6 +254,7 @@ impl Supervisor {
         }
         self.arrangement.sensing_range_m = a.sensing_range_m;
         self.imposed_releasing = a.releasing;
+        self.blocked = a.blocked; // a follower's own rules never set it
     }
 
     /// The active arrangement.
@@ -276,7 +277,8 @@ impl Supervisor {
         &self.tasks
     }
 
-    /// Why the arm holds in (a) instead of pushing again (`None`: not blocked).
+    /// Why the arm holds in (a) instead of pushing again (`None`: not blocked). A follower
+    /// ([`Self::impose`]) has the deciding supervisor's.
     pub fn blocked(&self) -> Option<Blocked> {
         self.blocked
     }

@@ -730,6 +730,7 @@ fn follower_reproduces_the_deciding_supervisor() {
                     sensing_range_m: a.sensing_range_m,
                     fusion_weight_target: a.fusion_weight_target,
                     releasing: decider.releasing(),
+                    blocked: decider.blocked(),
                 })
                 .unwrap();
             let f = follower.update(t, &SupervisorInput::default()).clone();
@@ -738,6 +739,7 @@ fn follower_reproduces_the_deciding_supervisor() {
             assert_eq!(f.switch_time_s.to_bits(), a.switch_time_s.to_bits());
             assert_eq!(f.sensing_range_m, a.sensing_range_m);
             assert_eq!(follower.releasing(), decider.releasing(), "cycle {k}");
+            assert_eq!(follower.blocked(), decider.blocked(), "cycle {k}");
             if follower.releasing() {
                 seen[usize::from(f.mode != Mode::HardContact)] = true;
             }
@@ -760,6 +762,7 @@ fn follower_reproduces_the_deciding_supervisor() {
         sensing_range_m: 0.1,
         fusion_weight_target: 0.0,
         releasing: false,
+        blocked: None,
     };
     assert!(s.impose(bad).is_err());
 }

@@ -145,6 +145,8 @@ pub struct Imposed {
     pub fusion_weight_target: f64,
     /// The deciding supervisor's [`crate::supervisor::Supervisor::releasing`].
     pub releasing: bool,
+    /// The deciding supervisor's [`crate::supervisor::Supervisor::blocked`].
+    pub blocked: Option<Blocked>,
 }
 
 /// One arrangement switch.

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use skin_core::model::BASE_JOINTS;
-use skin_core::supervisor::Mode;
+use skin_core::supervisor::{Blocked, Mode};
 
 use nalgebra::{Isometry3, Quaternion as NaQuaternion, Translation3, UnitQuaternion};
 use skin_core::skin::markers::{MarkerAction, MarkerShape, Rgba, SkinMarker};
@@ -19,8 +19,8 @@ use crate::outputs::report::{MetricsJson, RunOutput, RunReport, SummaryText};
 use crate::outputs::view::{View, ODOM_FRAME};
 use crate::world::KeyFrame;
 use skin_bag::msgs::{
-    Arrangement, Clock, ColorRgba, ControllerState, Float64MultiArray, Header, JointState, Marker, MarkerArray, Point,
-    Quaternion, StringMsg, TfMessage, Time, Transform, TransformStamped, Twist, Vector3,
+    Arrangement, BlockedHold, Clock, ColorRgba, ControllerState, Float64MultiArray, Header, JointState, Marker,
+    MarkerArray, Point, Quaternion, StringMsg, TfMessage, Time, Transform, TransformStamped, Twist, Vector3,
 };
 use skin_bag::{full_definition, BagWriter, RosMessage, TRANSIENT_LOCAL_QOS};
 
@@ -256,8 +256,18 @@ fn arrangement_msg(c: &CycleRecord, t_s: f64) -> Arrangement {
         mode: c.mode.as_u8(),
         switch_time: Time::from_nanos(nanos(t_s)),
         releasing: c.releasing,
+        blocked: blocked_hold(c.blocked),
         ..Default::default()
     }
+}
+
+fn blocked_hold(b: Option<Blocked>) -> BlockedHold {
+    b.map_or_else(BlockedHold::default, |b| BlockedHold {
+        active: true,
+        since: Time::from_nanos(nanos(b.since_s)),
+        goal_error: b.goal_error_m,
+        contact_force: b.contact_force_n,
+    })
 }
 
 fn write_view_frame(bag: &mut BagWriter, view: &View, f: &KeyFrame) -> anyhow::Result<()> {
@@ -330,7 +340,9 @@ impl RunOutput for RunBag {
                 contact_force: s.contact_force_n,
                 torque_norm: c.torque_norm,
                 goal_error: if s.goal_error_m.is_nan() { -1.0 } else { s.goal_error_m },
-                tasks: Vec::new(),
+                releasing: c.releasing,
+                blocked: blocked_hold(c.blocked),
+                tasks: Vec::new(), // and goal_count 0: the record keeps neither
                 // in process every cycle runs on fresh inputs, no input is ever bad
                 safe_stop_cycles: safe_stops,
                 ..Default::default()

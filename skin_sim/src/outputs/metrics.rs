@@ -309,10 +309,10 @@ fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: &Limits) -> GoalM
         hard_contact_recovery_s: recovery,
         outcome: match cycles.last() {
             _ if error <= limits.goal_tolerance_m => "reached",
-            Some(c) if c.blocked => "blocked",
+            Some(c) if c.blocked.is_some() => "blocked",
             _ => "not_reached",
         },
-        blocked_at_s: cycles.iter().find(|c| c.blocked).map_or(f64::NAN, |c| c.t_s),
+        blocked_at_s: cycles.iter().find(|c| c.blocked.is_some()).map_or(f64::NAN, |c| c.t_s),
     }
 }
 
@@ -396,7 +396,7 @@ mod tests {
             joint_velocities: vec![],
             base_twist: [0.0; 3],
             mode: Mode::Contact,
-            blocked: false,
+            blocked: None,
             releasing: false,
             blend: 0.0,
             fusion_weight: 1.0,

@@ -3,7 +3,7 @@
 //! bag writer (the `skin_bag` crate) read. Plain data; nothing in it is computed twice.
 
 use crate::world::{BusyTime, KeyFrame};
-use skin_core::supervisor::{Mode, SupervisorInput};
+use skin_core::supervisor::{Blocked, Mode, SupervisorInput};
 
 use crate::outputs::view::View;
 
@@ -24,13 +24,11 @@ pub struct CycleRecord {
     pub base_twist: [f64; 3],
     /// Active arrangement (intentional-contact paper Table I / interactive-force-control paper Table 1).
     pub mode: Mode,
-    /// The supervisor holds the arm in (a) after a push that reached `ε_c`
-    /// (`skin_core::supervisor::Blocked`); always false when the controller ran elsewhere
-    /// (`ControllerState.msg` does not carry it yet).
-    pub blocked: bool,
+    /// Why the supervisor holds the arm in (a) after a push that reached `ε_c` (`None`: not
+    /// blocked; `ControllerState.blocked` when the controller ran elsewhere).
+    pub blocked: Option<Blocked>,
     /// Nothing is to be pressed: in a hard contact (c) and in the blocked hold after a push given
-    /// up (`skin_core::supervisor::Supervisor::releasing`); always false when the controller ran
-    /// elsewhere (`ControllerState.msg` does not carry it).
+    /// up (`skin_core::supervisor::Supervisor::releasing`, `ControllerState.releasing`).
     pub releasing: bool,
     /// `χ` of intentional-contact paper eq. (10)-(11), 0 outside a blend.
     pub blend: f64,

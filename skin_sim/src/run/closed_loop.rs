@@ -182,7 +182,7 @@ impl ClosedLoop {
             joint_velocities: out.commands.joint_velocities.clone(),
             base_twist: out.commands.base_twist,
             mode: out.mode,
-            blocked: out.blocked.is_some(),
+            blocked: out.blocked,
             releasing: out.releasing,
             blend: out.blend,
             fusion_weight: out.fusion_weight,

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use skin_core::controller::Controller;
-use skin_core::supervisor::{Mode, SupervisorInput};
+use skin_core::supervisor::{Blocked, Mode, SupervisorInput};
 
 use crate::outputs::metrics::{self, Limits};
 use crate::outputs::outcome;
@@ -122,6 +122,10 @@ pub struct Decision {
     pub base_twist: [f64; 3],
     /// Active arrangement.
     pub mode: Mode,
+    /// Why the arm holds in (a) after a push given up (`ControllerState.blocked`).
+    pub blocked: Option<Blocked>,
+    /// Nothing is to be pressed (`ControllerState.releasing`).
+    pub releasing: bool,
     /// Blend factor `χ`.
     pub blend: f64,
     /// Fusion weight of the skin (the graph publishes the arrangement's target).
@@ -198,8 +202,8 @@ impl ExternalRun {
             joint_velocities: decision.joint_velocities,
             base_twist: decision.base_twist,
             mode: decision.mode,
-            blocked: false,   // not in ControllerState.msg yet
-            releasing: false, // nor this
+            blocked: decision.blocked,
+            releasing: decision.releasing,
             blend: decision.blend,
             fusion_weight: decision.fusion_weight,
             signals: decision.signals,

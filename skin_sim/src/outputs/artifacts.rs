@@ -141,6 +141,7 @@ impl RunOutput for FigurePng {
         } else {
             // Table I's (a), (b), (c) are modes 0, 1, 2
             let arrangement: Vec<usize> = c.iter().map(|c| (c.mode.as_u8() as usize).min(2)).collect();
+            let pushes: Vec<(f64, f64)> = r.object_pushes.iter().chain(&interactions).copied().collect();
             intentional_contact_figure(
                 &title,
                 &IntentionalContactSignals {
@@ -152,7 +153,8 @@ impl RunOutput for FigurePng {
                     contact_force: &column(c, |c| c.link_force_n),
                     eps_c: r.eps_c_n,
                     torque_norm: &column(c, |c| c.torque_norm),
-                    pushes: &interactions,
+                    pushes: &pushes,
+                    blocked: &c.iter().map(|c| c.blocked.is_some()).collect::<Vec<_>>(),
                 },
             )
         };

@@ -100,6 +100,9 @@ pub struct RunRecord {
     pub eps_v_mps: f64,
     /// The supervisor's contact force limit `ε_c` \[N\] (intentional-contact paper Table I).
     pub eps_c_n: f64,
+    /// The scene's scripted pushes on objects `(start, end)` \[s\] (intentional-contact paper
+    /// Fig. 2d: the obstacle pushed into the arm).
+    pub object_pushes: Vec<(f64, f64)>,
     /// One entry per control cycle, in time order.
     pub cycles: Vec<CycleRecord>,
     /// Arrangement switches in time order.

@@ -23,13 +23,16 @@ pub struct IntentionalContactSignals<'a> {
     pub eps_c: f64,
     /// Norm of the commanded torque ||tau|| \[N m\].
     pub torque_norm: &'a [f64],
-    /// Scripted external pushes `(start, end)` \[s\], shaded (the hard-contact scenario).
+    /// Scripted external pushes `(start, end)` \[s\], on objects (the hard-contact scenario) or
+    /// on the robot, shaded.
     pub pushes: &'a [(f64, f64)],
+    /// Per sample: the arm holds blocked after a push given up (`docs/supervisor.md`).
+    pub blocked: &'a [bool],
 }
 
 /// Intentional-contact paper's figure: (a) arrangement, (b) end-effector speed with eps_v, (c) proximity force,
-/// (d) contact force with eps_c, (e) torque norm; intentional-contact periods (arrangement (b))
-/// and pushes shaded.
+/// (d) contact force with eps_c, (e) torque norm; intentional-contact periods (arrangement (b)),
+/// blocked holds and pushes shaded.
 pub fn intentional_contact_figure(title: &str, s: &IntentionalContactSignals) -> Figure {
     let t = s.t;
     let contact: Vec<bool> = s.arrangement.iter().map(|&a| a == 1).collect();
@@ -57,11 +60,9 @@ pub fn intentional_contact_figure(title: &str, s: &IntentionalContactSignals) ->
                 .threshold("eps_c", s.eps_c),
         )
         .panel(Panel::lines("(e) Torque norm", "torque [N m]").line("||tau||", t, s.torque_norm));
-    fig.shade_all(&intervals_where(t, &contact), "intentional contact", Tint::Green).shade_all(
-        s.pushes,
-        "external push",
-        Tint::Red,
-    )
+    fig.shade_all(&intervals_where(t, &contact), "intentional contact", Tint::Green)
+        .shade_all(&intervals_where(t, s.blocked), "blocked hold", Tint::Gray)
+        .shade_all(s.pushes, "external push", Tint::Red)
 }
 
 /// Signals of an interactive-force-control paper force experiment, laid out like its Figs. 5, 7 and 8; one sample per

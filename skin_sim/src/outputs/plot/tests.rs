@@ -22,6 +22,7 @@ fn intentional_contact_run() -> Figure {
     let prox: Vec<f64> = t.iter().map(|t| 4.0 * (-(t - 5.0) * (t - 5.0)).exp()).collect();
     let contact: Vec<f64> = t.iter().map(|&t| if (7.0..12.0).contains(&t) { 3.0 } else { 0.0 }).collect();
     let torque: Vec<f64> = t.iter().map(|t| 10.0 + 5.0 * (0.5 * t).cos()).collect();
+    let blocked: Vec<bool> = t.iter().map(|&t| (12.5..14.0).contains(&t)).collect();
     let signals = IntentionalContactSignals {
         t: &t,
         arrangement: &arrangement,
@@ -32,6 +33,7 @@ fn intentional_contact_run() -> Figure {
         eps_c: 5.0,
         torque_norm: &torque,
         pushes: &[(14.0, 15.0)],
+        blocked: &blocked,
     };
     intentional_contact_figure("synthetic intentional-contact paper run", &signals)
 }

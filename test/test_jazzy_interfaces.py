@@ -8,7 +8,8 @@ real Fast DDS with rclpy as the robot (test_failsafe.Robot):
   with an error naming the topic;
 - `base_command_stamped`: /base/cmd_vel as geometry_msgs/TwistStamped in frame base_link with a
   fresh stamp; skin_watchdog --base-stamped zeroes the base in the same type;
-- `/diagnostics` (diagnostic_msgs/DiagnosticArray): the control loop and one status per input;
+- `/diagnostics` (diagnostic_msgs/DiagnosticArray): the control loop, the task hierarchy and one
+  status per input;
   joint states that stop make the joint-state input and the loop ERROR, naming the input."""
 import signal
 import time
@@ -168,8 +169,12 @@ def test_diagnostics_report_input_health_cycle_time_and_state(spawn, rclpy_node)
     spin_until(rclpy_node, lambda: len(diag.arrays) > n, 10.0, "one more report")
     report = diag.statuses(n)[0]
     names = set(report)
-    assert {loop, joints, "task_controller: input /base/odom", "task_controller: input /skin/cells",
+    hierarchy = "task_controller: task hierarchy"
+    assert {loop, hierarchy, joints, "task_controller: input /base/odom", "task_controller: input /skin/cells",
             "task_controller: input /scan"} <= names, names
+    h = values(report[hierarchy])
+    assert h["mode"] in {"avoidance", "intentional_contact", "hard_contact"} and "goal" in h["tasks"].split(" > "), h
+    assert level(report[hierarchy]) == OK and report[hierarchy].message == f"{h['mode']}: {h['tasks']}", h
     v = values(report[loop])
     assert v["lifecycle state"] == "active" and float(v["cycle time max [ms]"]) >= float(v["cycle time mean [ms]"]) > 0, v
     assert int(v["cycles in the last period"]) > 0 and "overruns" in v, v

@@ -2,13 +2,17 @@
 //! diagnostic_updater publishes them, for rqt_robot_monitor and diagnostic_aggregator: once per
 //! [`PERIOD`] on the global [`TOPIC`], each status named `<node>: <what>` (the node's name
 //! without the leading `/`), `hardware_id` the robot's name from the URDF. One status for the
-//! control loop (state, cycle time, overruns) and one per required input (ok, waiting, stale or
-//! skewed, with its age).
+//! control loop (state, cycle time, overruns), one for the task hierarchy (the arrangement
+//! followed, and a push given up: the blocked hold, WARN, with its reason) and one per required
+//! input (ok, waiting, stale or skewed, with its age).
 use std::time::Duration;
 
 use r2r::builtin_interfaces::msg::Time;
 use r2r::diagnostic_msgs::msg::{DiagnosticArray, DiagnosticStatus, KeyValue};
 use r2r::std_msgs::msg::Header;
+
+use skin_core::controller::Controller;
+use skin_core::supervisor::Blocked;
 
 use crate::input_health::{fresh, IssueTable, StampIssue};
 use crate::task_controller::InputAge;
@@ -104,6 +108,33 @@ pub struct LoopReport {
     pub idle_periods: u64,
 }
 
+/// The task hierarchy at a report: the arrangement in force and the blocked hold.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HierarchyReport {
+    /// The arrangement's mode (`Mode::name`).
+    pub mode: &'static str,
+    /// Its tasks, highest priority first.
+    pub tasks: Vec<String>,
+    /// Nothing is to be pressed (a hard contact, the blocked hold).
+    pub releasing: bool,
+    /// Why the arm holds after a push given up.
+    pub blocked: Option<Blocked>,
+}
+
+impl HierarchyReport {
+    /// The hierarchy of `controller`'s last cycle.
+    pub fn of(controller: &Controller) -> Self {
+        let sup = controller.supervisor();
+        let out = controller.output();
+        HierarchyReport {
+            mode: out.mode.name(),
+            tasks: sup.arrangement().task_names(sup.tasks()).map(str::to_string).collect(),
+            releasing: out.releasing,
+            blocked: out.blocked,
+        }
+    }
+}
+
 /// Builds the reports of one node; remembers the input issue counts of the last report (an
 /// input whose messages were refused since then is at least WARN).
 #[derive(Debug, Clone)]
@@ -143,6 +174,21 @@ impl Diagnostics {
         }
     }
 
+    fn hierarchy_status(&self, h: &HierarchyReport) -> DiagnosticStatus {
+        let order = h.tasks.join(" > ");
+        let mut values = vec![kv("mode", h.mode), kv("tasks", &order), kv("releasing", h.releasing)];
+        let (level, message) = match &h.blocked {
+            None => (level::OK, format!("{}: {order}", h.mode)),
+            Some(b) => {
+                values.push(kv("blocked since [s]", format!("{:.3}", b.since_s)));
+                values.push(kv("blocking force [N]", format!("{:.2}", b.contact_force_n)));
+                values.push(kv("goal error then [m]", format!("{:.3}", b.goal_error_m)));
+                (level::WARN, format!("blocked: {b}"))
+            }
+        };
+        self.status("task hierarchy", level, message, values)
+    }
+
     /// A report before the controller exists: the control loop WAITING for `what`.
     pub fn waiting(&self, stamp: Time, what: &str) -> DiagnosticArray {
         let lp = self.status(
@@ -155,11 +201,13 @@ impl Diagnostics {
     }
 
     /// The report at `now_s` (the node's clock, for the ages), stamped `stamp`: the control
-    /// loop `lp`, then one status per input of `inputs`, with its counters from `issues`.
+    /// loop `lp`, the task hierarchy `h`, then one status per input of `inputs`, with its
+    /// counters from `issues`.
     pub fn report(
         &mut self,
         stamp: Time,
         lp: &LoopReport,
+        h: &HierarchyReport,
         inputs: &[InputAge],
         max_lead_s: f64,
         issues: &IssueTable,
@@ -183,6 +231,7 @@ impl Diagnostics {
                 kv("idle periods", lp.idle_periods),
             ],
         )];
+        status.push(self.hierarchy_status(h));
         let future = StampIssue::Future.name();
         let mut counts = Vec::new();
         for input in inputs {
@@ -244,6 +293,26 @@ mod tests {
         }
     }
 
+    fn hierarchy(blocked: Option<Blocked>) -> HierarchyReport {
+        HierarchyReport {
+            mode: "avoidance",
+            tasks: vec!["avoidance".into(), "goal".into()],
+            releasing: blocked.is_some(),
+            blocked,
+        }
+    }
+
+    /// A push given up is a WARN with its reason, what an operator needs to step in.
+    #[test]
+    fn the_blocked_hold_is_a_warning_with_its_reason() {
+        let d = Diagnostics::new("/task_controller", "planar7");
+        let b = Blocked { since_s: 11.01, goal_error_m: 0.129, contact_force_n: 6.95 };
+        let s = d.hierarchy_status(&hierarchy(Some(b)));
+        assert_eq!(s.level, level::WARN);
+        assert!(s.message.starts_with("blocked: the push was given up at t = 11.010 s (6.95 N"), "{}", s.message);
+        assert_eq!((value(&s, "blocking force [N]"), value(&s, "releasing")), ("6.95", "true"));
+    }
+
     fn value<'a>(s: &'a DiagnosticStatus, key: &str) -> &'a str {
         &s.values.iter().find(|v| v.key == key).unwrap_or_else(|| panic!("{key} in {:?}", s.values)).value
     }
@@ -274,19 +343,21 @@ mod tests {
             },
             InputAge { topic: "/scan", age_s: None, timeout_s: 0.25, detail: None },
         ];
-        let a = d.report(time_msg(3.0), &lp(), &inputs, 0.02, &table);
-        assert_eq!(a.status.len(), 3);
+        let a = d.report(time_msg(3.0), &lp(), &hierarchy(None), &inputs, 0.02, &table);
+        assert_eq!(a.status.len(), 4);
         let names: Vec<&str> = a.status.iter().map(|s| s.name.as_str()).collect();
         assert_eq!(
             names,
             [
                 "tomm/task_controller: control loop",
+                "tomm/task_controller: task hierarchy",
                 "tomm/task_controller: input /joint_states",
                 "tomm/task_controller: input /scan"
             ]
         );
         assert!(a.status.iter().all(|s| s.hardware_id == "tomm"));
-        let (lp_s, js_s, scan) = (&a.status[0], &a.status[1], &a.status[2]);
+        let (lp_s, js_s, scan) = (&a.status[0], &a.status[2], &a.status[3]);
+        assert_eq!((a.status[1].level, a.status[1].message.as_str()), (level::OK, "avoidance: avoidance > goal"));
         assert_eq!((value(lp_s, "cycle time mean [ms]"), value(lp_s, "cycle time max [ms]")), ("2.000", "3.000"));
         assert_eq!((value(lp_s, "overruns"), value(lp_s, "late periods")), ("1", "2"));
         assert_eq!(js_s.level, level::ERROR);
@@ -296,17 +367,17 @@ mod tests {
 
         // future stamps refused since the last report: skewed, and the counts say so
         table.count(js + StampIssue::Future as usize);
-        let b = d.report(time_msg(4.0), &lp(), &inputs, 0.02, &table);
-        assert_eq!(b.status[1].level, level::ERROR);
-        assert!(b.status[1].message.starts_with("skewed: 0.500 s old"), "{}", b.status[1].message);
+        let b = d.report(time_msg(4.0), &lp(), &hierarchy(None), &inputs, 0.02, &table);
+        assert_eq!(b.status[2].level, level::ERROR);
+        assert!(b.status[2].message.starts_with("skewed: 0.500 s old"), "{}", b.status[2].message);
         assert!(
-            b.status[1].message.ends_with("since the last report: stamp in the future: 1"),
+            b.status[2].message.ends_with("since the last report: stamp in the future: 1"),
             "{}",
-            b.status[1].message
+            b.status[2].message
         );
         let fresh = [InputAge { age_s: Some(0.01), ..inputs[0].clone() }];
-        let c = d.report(time_msg(5.0), &lp(), &fresh, 0.02, &table);
-        assert_eq!((c.status[1].level, value(&c.status[1], "stamp in the future")), (level::OK, "1"), "nothing new");
+        let c = d.report(time_msg(5.0), &lp(), &hierarchy(None), &fresh, 0.02, &table);
+        assert_eq!((c.status[2].level, value(&c.status[2], "stamp in the future")), (level::OK, "1"), "nothing new");
         let w = d.waiting(time_msg(0.0), "the URDF on /robot_description");
         assert_eq!(
             (w.status[0].level, w.status[0].message.as_str()),

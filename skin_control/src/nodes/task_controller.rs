@@ -22,7 +22,7 @@ use skin_core::param_file::declare::Declared;
 
 use super::{file_setting, local, resolve, resolved, ros_now, OnceLog};
 use crate::convert::robot::time_msg;
-use crate::diagnostics::{self, level, Diagnostics, LoopReport};
+use crate::diagnostics::{self, level, Diagnostics, HierarchyReport, LoopReport};
 use crate::heartbeat::{self, CommandType, Commander};
 use crate::lifecycle::{self, Lifecycle};
 use crate::qos;
@@ -369,7 +369,8 @@ impl Shared {
         };
         let inputs = self.tc.input_ages(now);
         let stamp = time_msg(system_now_s());
-        let report = self.diagnostics.report(stamp, &lp, &inputs, p.max_stamp_lead_s, self.tc.issues());
+        let hierarchy = HierarchyReport::of(self.tc.controller());
+        let report = self.diagnostics.report(stamp, &lp, &hierarchy, &inputs, p.max_stamp_lead_s, self.tc.issues());
         if let Err(e) = self.diagnostics_pub.publish(&report) {
             if !std::mem::replace(&mut self.publish_failed, true) {
                 r2r::log_error!(&self.logger, "{}: {e}", diagnostics::TOPIC);

@@ -628,11 +628,7 @@ impl TaskController {
             notes.push(format!("following mode {} {:?}", msg.mode, msg.task_order));
         }
         match (before.is_some_and(|b| b.2), imposed.blocked) {
-            (false, Some(b)) => notes.push(format!(
-                "blocked: the push was given up at t = {:.3} s ({:.2} N against eps_c, the goal {:.3} m away); \
-                 holding until a new goal, goal progress or nothing in range",
-                b.since_s, b.contact_force_n, b.goal_error_m
-            )),
+            (false, Some(b)) => notes.push(format!("blocked: {b}")),
             (true, None) => notes.push("the blocked hold ended".to_string()),
             _ => {}
         }

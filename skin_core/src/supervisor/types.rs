@@ -131,6 +131,18 @@ pub struct Blocked {
     pub contact_force_n: f64,
 }
 
+impl std::fmt::Display for Blocked {
+    /// What an operator reads: when, how hard and how far from the goal the push was given up.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the push was given up at t = {:.3} s ({:.2} N against eps_c, the goal {:.3} m away); \
+             holding until a new goal, goal progress or nothing in range",
+            self.since_s, self.contact_force_n, self.goal_error_m
+        )
+    }
+}
+
 /// An arrangement decided by another supervisor with the same configuration: what
 /// `Arrangement.msg` carries.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -74,7 +74,7 @@ def expected(ts):
         ("/supervisor/arrangement", 9 * S, T["skin_msgs/msg/Arrangement"](
             mode=1, task_order=["goal", "contact_reaction", "avoidance"],
             switch_time=Time(sec=8, nanosec=500_000_000), smoothing_gain=5.0, sensing_range=0.05,
-            fusion_weight=0.75, releasing=True, blocked=T["skin_msgs/msg/BlockedHold"](
+            fusion_weight=0.75, blocked=T["skin_msgs/msg/BlockedHold"](
                 active=True, since=Time(sec=7, nanosec=125_000_000), goal_error=0.25,
                 contact_force=5.5))),
         ("/controller/state", 10 * S, T["skin_msgs/msg/ControllerState"](

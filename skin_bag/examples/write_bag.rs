@@ -142,7 +142,6 @@ fn samples(v: &mut impl Visit) -> Result<()> {
             smoothing_gain: 5.0,
             sensing_range: 0.05,
             fusion_weight: 0.75,
-            releasing: true,
             blocked: BlockedHold {
                 active: true,
                 since: Time { sec: 7, nanosec: 125_000_000 },

@@ -307,8 +307,6 @@ pub struct Arrangement {
     pub sensing_range: f64,
     /// Fusion weight, \[0, 1\].
     pub fusion_weight: f64,
-    /// Nothing is to be pressed: in a hard contact and in the blocked hold after a push given up.
-    pub releasing: bool,
     /// The blocked hold.
     pub blocked: BlockedHold,
 }

@@ -44,7 +44,7 @@ impl PrioritySupervisor {
 
     /// The active arrangement as a message.
     pub fn current(&self) -> ArrangementMsg {
-        arrangement_msg(self.sup.arrangement(), self.sup.tasks(), self.sup.releasing(), self.sup.blocked())
+        arrangement_msg(self.sup.arrangement(), self.sup.tasks(), self.sup.blocked())
     }
 
     /// Takes one controller state; returns the arrangement to publish when it differs from the
@@ -150,12 +150,12 @@ mod tests {
         assert_eq!(feed(&mut s, 10, 20.0, 7).mode, 2, "the push reached eps_c: (c)");
         let held = feed(&mut s, 500, 0.0, 7);
         assert_eq!(held.mode, 0);
-        assert!(held.releasing && held.blocked.active, "{held:?}");
+        assert!(s.supervisor().releasing() && held.blocked.active, "{held:?}");
         assert_eq!((held.blocked.goal_error, held.blocked.contact_force), (0.2, 20.0));
         let held = feed(&mut s, 2500, 0.0, 7);
         assert!(held.blocked.active && held.mode == 0, "10 s still stuck: held, no second push");
         let freed = feed(&mut s, 1, 0.0, 8);
-        assert!(!freed.blocked.active && !freed.releasing, "a new goal ends the hold: {freed:?}");
+        assert!(!freed.blocked.active && !s.supervisor().releasing(), "a new goal ends the hold: {freed:?}");
         assert_eq!(feed(&mut s, 1000, 0.0, 8).mode, 1, "and the arm may push toward it");
     }
 

@@ -206,9 +206,9 @@ pub fn blocked_of(msg: &BlockedHold) -> Option<Blocked> {
     })
 }
 
-/// The message of an arrangement (`tasks`: the configured task names; `releasing` and
-/// `blocked`: [`skin_core::supervisor::Supervisor::releasing`] and `blocked`).
-pub fn arrangement_msg(a: &Arrangement, tasks: &[String], releasing: bool, blocked: Option<Blocked>) -> ArrangementMsg {
+/// The message of an arrangement (`tasks`: the configured task names; `blocked`:
+/// [`skin_core::supervisor::Supervisor::blocked`]).
+pub fn arrangement_msg(a: &Arrangement, tasks: &[String], blocked: Option<Blocked>) -> ArrangementMsg {
     ArrangementMsg {
         mode: a.mode.as_u8(),
         task_order: a.task_names(tasks).map(str::to_string).collect(),
@@ -216,7 +216,6 @@ pub fn arrangement_msg(a: &Arrangement, tasks: &[String], releasing: bool, block
         smoothing_gain: a.smoothing_gain_per_s,
         sensing_range: a.sensing_range_m,
         fusion_weight: a.fusion_weight_target,
-        releasing,
         blocked: blocked_hold_msg(blocked),
     }
 }
@@ -248,7 +247,6 @@ pub fn imposed_of(msg: &ArrangementMsg, configured: impl Fn(Mode) -> Vec<String>
         switch_time_s: time_s(&msg.switch_time),
         sensing_range_m: msg.sensing_range,
         fusion_weight_target: msg.fusion_weight,
-        releasing: msg.releasing,
         blocked: blocked_of(&msg.blocked),
     })
 }
@@ -299,7 +297,6 @@ mod tests {
             smoothing_gain: 10.0,
             sensing_range: 0.05,
             fusion_weight: 0.5,
-            releasing: true,
             blocked: blocked_hold_msg(Some(Blocked { since_s: 2.5, goal_error_m: 0.2, contact_force_n: f64::NAN })),
         };
         let cfg = |m: Mode| {
@@ -311,8 +308,7 @@ mod tests {
         };
         let a = imposed_of(&msg, cfg).unwrap();
         assert_eq!((a.mode, a.switch_time_s, a.sensing_range_m), (Mode::IntentionalContact, 2.5, 0.05));
-        assert!(a.releasing);
-        let b = a.blocked.expect("blocked");
+        let b = a.blocked.expect("blocked: a follower presses nothing");
         assert_eq!((b.since_s, b.goal_error_m), (2.5, 0.2));
         assert!(b.contact_force_n.is_nan());
         assert_eq!(blocked_hold_msg(None), BlockedHold::default());

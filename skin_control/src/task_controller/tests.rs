@@ -401,12 +401,11 @@ fn a_follower_logs_switches_and_the_blocked_hold_not_range_steps() {
     let config = ControllerConfig::load(&paths::resolve("config/controller/planar7.yaml").unwrap()).unwrap();
     let sup = Supervisor::new(&config.supervisor, 0.0).unwrap();
     let mut tc = TaskController::new(config.clone(), TaskControllerParams::defaults(&config), 0.0).unwrap();
-    let mut msg = arrangement_msg(sup.arrangement(), sup.tasks(), false, None);
+    let mut msg = arrangement_msg(sup.arrangement(), sup.tasks(), None);
     let note = tc.on_arrangement(&msg).unwrap().expect("the first arrangement");
     assert!(note.starts_with("following mode 0"), "{note}");
     msg.sensing_range *= 0.5;
     assert_eq!(tc.on_arrangement(&msg).unwrap(), None, "a range step is no news");
-    msg.releasing = true;
     msg.blocked = blocked_hold_msg(Some(Blocked { since_s: 11.0, goal_error_m: 0.17, contact_force_n: 7.35 }));
     let note = tc.on_arrangement(&msg).unwrap().expect("the hold");
     assert!(note.starts_with("blocked: the push was given up at t = 11.000 s (7.35 N"), "{note}");

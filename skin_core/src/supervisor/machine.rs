@@ -110,8 +110,6 @@ pub struct Supervisor {
     /// Following another supervisor ([`Supervisor::impose`]): its own rules are off.
     follower: bool,
     imposed: Option<Imposed>,
-    /// A follower's: the deciding supervisor's `releasing` of the imposed arrangement.
-    imposed_releasing: bool,
 }
 
 impl Supervisor {
@@ -166,7 +164,6 @@ impl Supervisor {
             log: TransitionLog::new(params.log_capacity),
             follower: false,
             imposed: None,
-            imposed_releasing: false,
         })
     }
 
@@ -253,7 +250,6 @@ impl Supervisor {
             self.switch(a.switch_time_s, a.mode, Cause::Imposed);
         }
         self.arrangement.sensing_range_m = a.sensing_range_m;
-        self.imposed_releasing = a.releasing;
         self.blocked = a.blocked; // a follower's own rules never set it
     }
 
@@ -288,11 +284,9 @@ impl Supervisor {
     /// obstacle there to the end of the run), and in the [`Blocked`] hold after a push given up,
     /// where the goal would drive the arm back into the obstacle that blocked it and into ε_c
     /// again. The skin's approach bound then lets nothing close on a sensed surface
-    /// (`docs/resolver.md`). A follower ([`Self::impose`]) has the deciding supervisor's.
+    /// (`docs/resolver.md`). A follower ([`Self::impose`]) applies the same rule to the
+    /// decider's mode and hold.
     pub fn releasing(&self) -> bool {
-        if self.follower {
-            return self.imposed_releasing;
-        }
         self.arrangement.mode == Mode::HardContact || self.blocked.is_some()
     }
 

@@ -729,7 +729,6 @@ fn follower_reproduces_the_deciding_supervisor() {
                     switch_time_s: a.switch_time_s,
                     sensing_range_m: a.sensing_range_m,
                     fusion_weight_target: a.fusion_weight_target,
-                    releasing: decider.releasing(),
                     blocked: decider.blocked(),
                 })
                 .unwrap();
@@ -761,7 +760,6 @@ fn follower_reproduces_the_deciding_supervisor() {
         switch_time_s: f64::NAN,
         sensing_range_m: 0.1,
         fusion_weight_target: 0.0,
-        releasing: false,
         blocked: None,
     };
     assert!(s.impose(bad).is_err());

@@ -155,8 +155,6 @@ pub struct Imposed {
     pub sensing_range_m: f64,
     /// The fusion weight `w` the deciding supervisor shifts to.
     pub fusion_weight_target: f64,
-    /// The deciding supervisor's [`crate::supervisor::Supervisor::releasing`].
-    pub releasing: bool,
     /// The deciding supervisor's [`crate::supervisor::Supervisor::blocked`].
     pub blocked: Option<Blocked>,
 }

@@ -257,7 +257,6 @@ fn arrangement_msg(c: &CycleRecord, t_s: f64) -> Arrangement {
     Arrangement {
         mode: c.mode.as_u8(),
         switch_time: Time::from_nanos(nanos(t_s)),
-        releasing: c.releasing,
         blocked: blocked_hold(c.blocked),
         ..Default::default()
     }

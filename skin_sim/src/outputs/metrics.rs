@@ -279,8 +279,7 @@ fn max_link_force(cycles: &[CycleRecord], keep: impl Fn(&CycleRecord) -> bool) -
 
 fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: &Limits) -> GoalMetrics {
     let eps = limits.eps_c_n;
-    let pushes: Vec<(f64, f64)> =
-        scene.spec.pushes.iter().filter(|p| p.object.is_some()).map(|p| (p.start_s, p.end_s)).collect();
+    let pushes = scene.spec.object_push_windows();
     let excused = |t: f64| pushes.iter().any(|&(a, b)| t >= a && t < b + RECOVERY_LIMIT_S);
     let recovery = pushes
         .iter()

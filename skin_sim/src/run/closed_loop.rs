@@ -109,7 +109,7 @@ impl ClosedLoop {
             seed: spec.seed,
             eps_v_mps: controller.config().supervisor.thresholds.speed_mps,
             eps_c_n: controller.config().supervisor.thresholds.contact_force_n,
-            object_pushes: spec.pushes.iter().filter(|p| p.object.is_some()).map(|p| (p.start_s, p.end_s)).collect(),
+            object_pushes: spec.object_push_windows(),
             cycles: Vec::new(),
             switches: Vec::new(),
             wall_time_s: 0.0,

@@ -60,6 +60,14 @@ pub struct SceneSpec {
     pub expect: Option<ExpectSpec>,
 }
 
+impl SceneSpec {
+    /// The windows `(start, end)` \[s\] of the pushes on objects (intentional-contact paper
+    /// Fig. 2d: the obstacle pushed into the arm).
+    pub fn object_push_windows(&self) -> Vec<(f64, f64)> {
+        self.pushes.iter().filter(|p| p.object.is_some()).map(|p| (p.start_s, p.end_s)).collect()
+    }
+}
+
 /// The outcome a run of the scene must show (`expect:`), beside what every run is checked for
 /// (`skin_sim::outputs::safety`) and what every scene of its kind must show (a force scene: the first
 /// touch, the rise, a finite from-touch RMS; a scene without goals and force references: no

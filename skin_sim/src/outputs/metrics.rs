@@ -385,38 +385,9 @@ pub fn first_contact_peak(contact: &[&CycleRecord]) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use skin_core::supervisor::SupervisorInput;
 
     fn cycle(t_s: f64, force: f64, reference: f64, interaction: bool) -> CycleRecord {
-        CycleRecord {
-            t_s,
-            q: vec![],
-            qd: vec![],
-            joint_velocities: vec![],
-            base_twist: [0.0; 3],
-            mode: Mode::Contact,
-            blocked: None,
-            releasing: false,
-            blend: 0.0,
-            fusion_weight: 1.0,
-            signals: SupervisorInput {
-                ee_speed_mps: 0.0,
-                avoidance_force_n: 0.0,
-                contact_force_n: 0.0,
-                goal_error_m: 0.0,
-            },
-            torque_norm: 0.0,
-            hand_force_n: force,
-            link_force_n: force,
-            hand_position_m: [0.0; 3],
-            hand_distance_m: 0.0,
-            hand_moment: [0.0; 3],
-            force_reference_n: reference,
-            force_reference_signal: 0.0,
-            interaction,
-            fault: None,
-            compute_us: 0.0,
-        }
+        CycleRecord { force_reference_n: reference, interaction, ..CycleRecord::at_rest(t_s, force) }
     }
 
     /// An impact at the touch, then tracking: the peak is the impact's, the from-touch RMS sees

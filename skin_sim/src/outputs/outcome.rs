@@ -150,6 +150,7 @@ mod tests {
                 joint_speed_over_limit_cycles: 0,
                 longest_contact_over_eps_c_s: 0.01,
                 max_switch_repeats_in_window: 1,
+                max_touches_per_s: 1,
             },
             goal: Some(GoalMetrics {
                 goal_reached: outcome == "reached",

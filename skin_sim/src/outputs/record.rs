@@ -68,6 +68,43 @@ pub struct CycleRecord {
     pub compute_us: f64,
 }
 
+#[cfg(test)]
+impl CycleRecord {
+    /// A cycle at `t_s` in the contact phase with nothing moving, the hand and link force `force_n`
+    /// (tests).
+    pub(crate) fn at_rest(t_s: f64, force_n: f64) -> Self {
+        CycleRecord {
+            t_s,
+            q: vec![],
+            qd: vec![],
+            joint_velocities: vec![],
+            base_twist: [0.0; 3],
+            mode: Mode::Contact,
+            blocked: None,
+            releasing: false,
+            blend: 0.0,
+            fusion_weight: 1.0,
+            signals: SupervisorInput {
+                ee_speed_mps: 0.0,
+                avoidance_force_n: 0.0,
+                contact_force_n: 0.0,
+                goal_error_m: 0.0,
+            },
+            torque_norm: 0.0,
+            hand_force_n: force_n,
+            link_force_n: force_n,
+            hand_position_m: [0.0; 3],
+            hand_distance_m: 0.0,
+            hand_moment: [0.0; 3],
+            force_reference_n: f64::NAN,
+            force_reference_signal: 0.0,
+            interaction: false,
+            fault: None,
+            compute_us: 0.0,
+        }
+    }
+}
+
 /// One arrangement switch of the supervisor.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Switch {

@@ -58,8 +58,12 @@ impl RunReport {
         let sf = &m.safety;
         let _ = writeln!(
             s,
-            "  safety: longest contact over eps_c {:.3} s, one switch at most {} times in 10 s, {} cycles over a joint velocity limit, {} non-finite commands",
-            sf.longest_contact_over_eps_c_s, sf.max_switch_repeats_in_window, sf.joint_speed_over_limit_cycles, sf.non_finite_command_cycles
+            "  safety: longest contact over eps_c {:.3} s, one switch at most {} times in 10 s, {} cycles over a joint velocity limit, {} non-finite commands, at most {} touches in 1 s",
+            sf.longest_contact_over_eps_c_s,
+            sf.max_switch_repeats_in_window,
+            sf.joint_speed_over_limit_cycles,
+            sf.non_finite_command_cycles,
+            sf.max_touches_per_s
         );
         if let Some(f) = &m.force {
             let _ = writeln!(

@@ -41,7 +41,17 @@ pub struct SafetyMetrics {
     /// The most times one arrangement switch (the same `from → to`) happened within any
     /// [`CHATTER_WINDOW_S`] window of the run.
     pub max_switch_repeats_in_window: usize,
+    /// The most touches of one second (see [`touch_times`]): a link bouncing on a surface, a
+    /// contact vibration that stays mostly under `ε_c` and so escapes the figures above. Reported,
+    /// not (yet) judged: docs/supervisor.md, "A hard contact that must last".
+    pub max_touches_per_s: usize,
 }
+
+/// A touch starts when a link force that had fallen to [`TOUCH_LOW`] `ε_c` rises to
+/// [`TOUCH_HIGH`] `ε_c`: from hardly touching to a real press.
+pub const TOUCH_LOW: f64 = 0.1;
+/// See [`TOUCH_LOW`].
+pub const TOUCH_HIGH: f64 = 0.5;
 
 /// What limits the safety figures compare with.
 #[derive(Debug, Clone, PartialEq)]
@@ -96,6 +106,22 @@ pub fn max_in_window(times_s: &[f64], window_s: f64) -> usize {
     most
 }
 
+/// The times at which a touch starts: the largest link force reaches `TOUCH_HIGH · ε_c` after
+/// having been at most `TOUCH_LOW · ε_c` (the run starts released).
+pub fn touch_times(cycles: &[CycleRecord], eps_c_n: f64) -> Vec<f64> {
+    let mut released = true;
+    let mut times = Vec::new();
+    for c in cycles {
+        if c.link_force_n <= TOUCH_LOW * eps_c_n {
+            released = true;
+        } else if released && c.link_force_n >= TOUCH_HIGH * eps_c_n {
+            released = false;
+            times.push(c.t_s);
+        }
+    }
+    times
+}
+
 /// The safety figures of `record`.
 pub fn compute(record: &RunRecord, limits: &SafetyLimits) -> SafetyMetrics {
     let cycles = &record.cycles;
@@ -113,6 +139,7 @@ pub fn compute(record: &RunRecord, limits: &SafetyLimits) -> SafetyMetrics {
         joint_speed_over_limit_cycles: cycles.iter().filter(|c| over_speed(c)).count(),
         longest_contact_over_eps_c_s: longest_over(cycles, |c| contact_limit(c, limits.eps_c_n)),
         max_switch_repeats_in_window: pairs.map(|(a, b)| repeats(a, b)).max().unwrap_or(0),
+        max_touches_per_s: max_in_window(&touch_times(cycles, limits.eps_c_n), 1.0),
     }
 }
 
@@ -158,12 +185,27 @@ mod tests {
     }
 
     #[test]
+    fn a_touch_is_a_rise_from_hardly_touching_to_a_press() {
+        // eps_c 5 N: a touch from <= 0.5 N to >= 2.5 N; a press that only wavers above 0.5 N is
+        // one touch, and a rise that stays under 2.5 N (2.4 N at 0.8 s) none
+        let forces = [0.0, 3.0, 1.0, 4.0, 0.4, 2.6, 2.0, 0.5, 2.4, 0.0, 6.0];
+        let cycles: Vec<CycleRecord> =
+            forces.iter().enumerate().map(|(i, &f)| CycleRecord::at_rest(i as f64 * 0.1, f)).collect();
+        let times = touch_times(&cycles, 5.0);
+        assert_eq!(times.len(), 3, "{times:?}");
+        assert!((times[1] - 0.5).abs() < 1e-12 && (times[2] - 1.0).abs() < 1e-12, "{times:?}");
+        assert_eq!(max_in_window(&times, 1.0), 3, "0.1, 0.5 and 1.0 s: within one second");
+        assert_eq!(max_in_window(&times[..2], 0.3), 1, "0.4 s apart");
+    }
+
+    #[test]
     fn every_kind_of_violation_is_reported_and_nan_is_one() {
         let safe = SafetyMetrics {
             non_finite_command_cycles: 0,
             joint_speed_over_limit_cycles: 0,
             longest_contact_over_eps_c_s: 0.5,
             max_switch_repeats_in_window: CHATTER_MAX_REPEATS,
+            max_touches_per_s: 50,
         };
         assert!(violations(&safe, 0).is_empty());
         assert_eq!(violations(&safe, 1).len(), 1);

@@ -238,7 +238,7 @@ pub fn compute(record: &RunRecord, scene: &Scene, limits: &Limits) -> Metrics {
             .collect(),
         faulted_cycles: cycles.iter().filter(|c| c.fault.is_some()).count(),
         safety: safety::compute(record, &limits.safety),
-        goal: (!scene.spec.goals.is_empty()).then(|| goal_metrics(cycles, scene, limits)),
+        goal: (!scene.spec.goals.is_empty()).then(|| goal_metrics(cycles, &record.object_pushes, limits)),
         force: (!scene.spec.force_references.is_empty()).then(|| force_metrics(cycles)),
         contact_free: (scene.spec.goals.is_empty() && scene.spec.force_references.is_empty())
             .then(|| contact_free_metrics(cycles, scene, limits)),
@@ -277,9 +277,9 @@ fn max_link_force(cycles: &[CycleRecord], keep: impl Fn(&CycleRecord) -> bool) -
     cycles.iter().filter(|c| keep(c)).map(|c| c.link_force_n).fold(0.0, f64::max)
 }
 
-fn goal_metrics(cycles: &[CycleRecord], scene: &Scene, limits: &Limits) -> GoalMetrics {
+/// `pushes`: the scene's pushes on objects, as the record keeps them.
+fn goal_metrics(cycles: &[CycleRecord], pushes: &[(f64, f64)], limits: &Limits) -> GoalMetrics {
     let eps = limits.eps_c_n;
-    let pushes = scene.spec.object_push_windows();
     let excused = |t: f64| pushes.iter().any(|&(a, b)| t >= a && t < b + RECOVERY_LIMIT_S);
     let recovery = pushes
         .iter()

@@ -81,7 +81,8 @@ fn shipped_params_load_and_errors_name_file_and_key() {
     assert!(matches!(e, ParamsError::Invalid { .. }));
     let msg = e.to_string();
     assert!(msg.contains("t.yaml") && msg.contains("base_avoidance.alpha_m"), "{msg}");
-    let unknown = text.replace("gain: 5.0", "gain: 5.0\n  extra: 2.0");
+    let unknown = text.replace("contact_reaction:\n", "contact_reaction:\n  extra: 2.0\n");
+    assert_ne!(unknown, text);
     let msg = TaskParams::from_yaml_str(&unknown, "u.yaml").unwrap_err().to_string();
     assert!(msg.contains("u.yaml") && msg.contains("extra"), "{msg}");
 }

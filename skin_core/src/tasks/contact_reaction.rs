@@ -37,9 +37,9 @@ pub struct ContactReaction {
 pub struct ContactSummary {
     /// Rows pushed (contact cells).
     pub rows: usize,
-    /// Largest task force `F_ci` \[N\] (`‖F_c‖` max).
+    /// Largest task force `F_ci = gain · F_i` \[N\].
     pub max_force_n: f64,
-    /// Largest measured cell force `F_i` \[N\].
+    /// Largest measured cell force `F_i` \[N\]: the supervisor's `‖F_c‖` (Table I).
     pub max_measured_n: f64,
 }
 

@@ -41,7 +41,7 @@ pub struct SafetyMetrics {
     /// The most times one arrangement switch (the same `from → to`) happened within any
     /// [`CHATTER_WINDOW_S`] window of the run.
     pub max_switch_repeats_in_window: usize,
-    /// The most touches of one second (see [`touch_times`]): a link bouncing on a surface, a
+    /// The most touches within [`TOUCH_WINDOW_S`] (see [`touch_times`]): a link bouncing on a surface, a
     /// contact vibration that stays mostly under `ε_c` and so escapes the figures above. Reported,
     /// not (yet) judged: docs/supervisor.md, "A hard contact that must last".
     pub max_touches_per_s: usize,
@@ -52,6 +52,8 @@ pub struct SafetyMetrics {
 pub const TOUCH_LOW: f64 = 0.1;
 /// See [`TOUCH_LOW`].
 pub const TOUCH_HIGH: f64 = 0.5;
+/// The window of `max_touches_per_s` \[s\].
+pub const TOUCH_WINDOW_S: f64 = 1.0;
 
 /// What limits the safety figures compare with.
 #[derive(Debug, Clone, PartialEq)]
@@ -139,7 +141,7 @@ pub fn compute(record: &RunRecord, limits: &SafetyLimits) -> SafetyMetrics {
         joint_speed_over_limit_cycles: cycles.iter().filter(|c| over_speed(c)).count(),
         longest_contact_over_eps_c_s: longest_over(cycles, |c| contact_limit(c, limits.eps_c_n)),
         max_switch_repeats_in_window: pairs.map(|(a, b)| repeats(a, b)).max().unwrap_or(0),
-        max_touches_per_s: max_in_window(&touch_times(cycles, limits.eps_c_n), 1.0),
+        max_touches_per_s: max_in_window(&touch_times(cycles, limits.eps_c_n), TOUCH_WINDOW_S),
     }
 }
 

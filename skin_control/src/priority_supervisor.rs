@@ -121,7 +121,8 @@ mod tests {
         let stale =
             ControllerState { input_status: ControllerState::INPUT_STALE as u8, ..state(0.025, 0.5, 0.0, 9.0, 0.3) };
         assert!(s.on_state(&stale).is_none() && s.updates() == 2, "a stale period's state is not an input");
-        let hard = s.on_state(&state(0.03, 0.5, 0.0, 6.0, 0.3)).unwrap();
+        let impact = state(0.03, 0.5, 0.0, params("intentional_contact").thresholds.impact_force_n, 0.3);
+        let hard = s.on_state(&impact).unwrap();
         assert_eq!(hard.mode, 2);
         assert_eq!(hard.switch_time, time_msg(0.03));
         let (ok, why) = s.request_phase(CONTACT);
@@ -146,8 +147,9 @@ mod tests {
             }
             last.clone().unwrap()
         };
-        assert_eq!(feed(&mut s, 1000, 0.0, 7).mode, 1, "stuck at an obstacle: (b)");
-        assert_eq!(feed(&mut s, 10, 20.0, 7).mode, 2, "the push reached eps_c: (c)");
+        // 2.4 s: stuck for `stuck_s`, then pushing for less than `push_stall_s`
+        assert_eq!(feed(&mut s, 600, 0.0, 7).mode, 1, "stuck at an obstacle: (b)");
+        assert_eq!(feed(&mut s, 30, 20.0, 7).mode, 2, "the push reached eps_c: (c)");
         let held = feed(&mut s, 500, 0.0, 7);
         assert_eq!(held.mode, 0);
         assert!(s.supervisor().releasing() && held.blocked.active, "{held:?}");
@@ -156,7 +158,7 @@ mod tests {
         assert!(held.blocked.active && held.mode == 0, "10 s still stuck: held, no second push");
         let freed = feed(&mut s, 1, 0.0, 8);
         assert!(!freed.blocked.active && !s.supervisor().releasing(), "a new goal ends the hold: {freed:?}");
-        assert_eq!(feed(&mut s, 1000, 0.0, 8).mode, 1, "and the arm may push toward it");
+        assert_eq!(feed(&mut s, 600, 0.0, 8).mode, 1, "and the arm may push toward it");
     }
 
     #[test]

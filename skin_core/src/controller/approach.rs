@@ -102,8 +102,9 @@ impl ApproachBound {
     ///   of the run);
     /// - in a push ([`ContactIntent::Push`]), growing by `push_accel_mps2` up to
     ///   `push_speed_max_mps` while the link is in contact (its cells' forces sum above no
-    ///   contact) and none of its cells is pressed at the release level of a hard contact (the
-    ///   level is the supervisor's, of the largest cell force `‖F_c‖`): it pushes something that
+    ///   contact) and none of its cells is pressed at the release level of a hard contact (a
+    ///   level of the supervisor's; compared per cell, not with the link's force `‖F_c‖`, which
+    ///   sums a spread contact past it and stopped pushes, `docs/resolver.md`): it pushes something that
     ///   slides (a push at the touch speed would take 10 s for 20 cm); falling back as fast when
     ///   the pushed thing slid ahead out of contact, and at once to the touch speed when a cell
     ///   is pressed at that level;

@@ -405,7 +405,7 @@ fn no_skin_point_closes_on_a_sensed_surface_faster_than_the_approach_bound() {
 /// The speed at contact of a link's cells (the limit at `d = 0`): the touch speed, growing by
 /// the push acceleration up to the fastest push while the link is in contact (its cells' forces
 /// sum above no contact) and none of its cells is pressed at the release level of a hard contact
-/// (the supervisor's `‖F_c‖`, the largest cell force) in a push (b); falling back as fast when
+/// (the supervisor's level, compared per cell) in a push (b); falling back as fast when
 /// the link is out of contact; back at the touch speed at once when a cell is pressed at that
 /// level and in any other arrangement; 0 for a cell at `ε_c` and when the contact is to be released.
 #[test]

@@ -83,19 +83,24 @@ pub struct Supervisor {
     arrangement: Arrangement,
     /// The mode (a) or (b) to return to when a hard contact (c) is released.
     resume: Mode,
-    /// Largest `‖F_c‖` of the current hard contact (c) (NaN counts as infinite).
-    hard_peak_n: f64,
+    /// Largest `‖F_c‖` since the last switch, in a push (b) or a hard contact (c) (NaN counts
+    /// as infinite).
+    peak_n: f64,
     /// A push that reached ε_c was given up: (a) holds, no (a) → (b).
     blocked: Option<Blocked>,
     /// Goal error when the current push began ((a) → (b)) or at its last hard contact: what the
     /// next hard contact's goal error is compared with (NaN: none).
     push_ref_error_m: f64,
-    /// Time of the last (b) → (c) (NaN: none yet).
+    /// Time the last push reached its limit: (b) → (c), or stalled (NaN: none yet).
     push_limit_s: f64,
     /// The hard contact (c) entered from (b) ends the push with another try (the push had got
     /// the goal nearer, and the one before did not also reach ε_c within `retry_interval_s`).
     retry: bool,
     over_limit: Dwell,
+    /// `‖F_c‖ ≥ ε_c` at the last update.
+    was_over: bool,
+    /// When `‖F_c‖` last rose to ε_c in this (a) or (b) (NaN: not yet).
+    last_strike_s: f64,
     released: Dwell,
     stuck: Dwell,
     goal_reached: Dwell,
@@ -145,12 +150,14 @@ impl Supervisor {
                 fusion_weight_target: w,
             },
             resume: Mode::Avoidance,
-            hard_peak_n: 0.0,
+            peak_n: 0.0,
             blocked: None,
             push_ref_error_m: f64::NAN,
             push_limit_s: f64::NAN,
             retry: false,
             over_limit: Dwell::IDLE,
+            was_over: false,
+            last_strike_s: f64::NAN,
             released: Dwell::IDLE,
             stuck: Dwell::IDLE,
             goal_reached: Dwell::IDLE,
@@ -312,6 +319,13 @@ impl Supervisor {
         let dw = self.dwell;
         let fc = u.contact_force_n;
         let over = fc.is_nan() || fc >= th.contact_force_n; // NaN counts as over the limit
+        let impact = fc.is_nan() || fc >= th.impact_force_n;
+        let strike = over && !self.was_over;
+        self.was_over = over;
+        let struck_again = strike && t - self.last_strike_s <= dw.hard_contact_repeat_s; // NaN: false
+        if strike {
+            self.last_strike_s = t;
+        }
         let below = fc < th.contact_force_n - th.contact_band_n; // NaN is never below
         let (v, fd, ge) = (u.ee_speed_mps, u.avoidance_force_n, u.goal_error_m);
         let invalid = v.is_nan() || fd.is_nan() || ge.is_nan();
@@ -319,7 +333,7 @@ impl Supervisor {
         match mode {
             Mode::Avoidance | Mode::IntentionalContact => {
                 // A hard contact can happen in (a) or (b): checked first, it has priority.
-                if self.over_limit.step(t, over, over, dw.hard_contact_s) {
+                if self.over_limit.step(t, over, over, dw.hard_contact_s) || impact || struck_again {
                     self.resume = mode;
                     if mode == Mode::IntentionalContact {
                         // Another try only if this push got the goal nearer (the obstacle gave
@@ -332,7 +346,7 @@ impl Supervisor {
                         self.push_limit_s = t;
                     }
                     self.switch(t, Mode::HardContact, Cause::ContactOverLimit);
-                    self.hard_peak_n = if fc.is_nan() { f64::INFINITY } else { fc };
+                    self.record_peak(fc);
                     return;
                 }
                 if mode == Mode::Avoidance {
@@ -373,6 +387,11 @@ impl Supervisor {
                     let g = self.goal_reached.step(t, reached, reached, dw.goal_reached_s);
                     let c = self.cleared.step(t, clear, clear, dw.clear_s);
                     let i = self.invalid.step(t, invalid, invalid, dw.clear_s);
+                    // A push that gets nowhere below ε_c (a rigid contact's touches each too short
+                    // for `hard_contact_s`, or a stall) is given up as one that reached ε_c.
+                    let no_progress = self.progress.step(t, ge, dw.push_stall_s, th.progress_min_m);
+                    let stalled = no_progress && ge > th.goal_tolerance_m + th.goal_band_m;
+                    self.record_peak(fc);
                     let cause = if g {
                         Some(Cause::GoalReached)
                     } else if c {
@@ -384,15 +403,22 @@ impl Supervisor {
                     };
                     if let Some(cause) = cause {
                         self.switch(t, Mode::Avoidance, cause);
+                    } else if stalled {
+                        self.blocked = Some(Blocked { since_s: t, goal_error_m: ge, contact_force_n: self.peak_n });
+                        self.push_limit_s = t;
+                        self.switch(t, Mode::Avoidance, Cause::PushStalled);
                     }
                 }
             }
             Mode::HardContact => {
-                self.hard_peak_n = if fc.is_nan() { f64::INFINITY } else { self.hard_peak_n.max(fc) };
+                self.record_peak(fc);
                 // Back to (b) when the force is below ε_c − band (Table I (b): `‖F_c‖ < ε_c`);
                 // back to (a) only when the contact is gone (Table I (a): `‖F_c‖ = 0`).
                 let to_b = self.resume == Mode::IntentionalContact && self.retry;
-                let released = if to_b { below } else { fc <= th.contact_zero_n }; // NaN: never
+                // A push given up is released into (a) below the band too: avoidance, first
+                // there, relieves the rest of the contact.
+                let pushed = self.resume == Mode::IntentionalContact;
+                let released = if pushed { below } else { fc <= th.contact_zero_n }; // NaN: never
                 if self.released.step(t, released, released, dw.contact_release_s) {
                     if to_b {
                         // The obstacle gave way before the push reached ε_c: push on.
@@ -401,8 +427,7 @@ impl Supervisor {
                         // The push of (b) reached ε_c without getting the goal nearer (or again
                         // too soon): pushing again would only hit ε_c again (the (b) <-> (c)
                         // cycle of a fixed or too heavy obstacle).
-                        self.blocked =
-                            Some(Blocked { since_s: t, goal_error_m: ge, contact_force_n: self.hard_peak_n });
+                        self.blocked = Some(Blocked { since_s: t, goal_error_m: ge, contact_force_n: self.peak_n });
                         self.switch(t, Mode::Avoidance, Cause::PushBlocked);
                     } else {
                         self.switch(t, self.resume, Cause::ContactReleased);
@@ -451,7 +476,12 @@ impl Supervisor {
         };
     }
 
-    /// Whether the last (b) → (c) is at least `retry_interval_s` before `t` (or there was none).
+    /// Keeps the largest `‖F_c‖` of this (b) or (c) (NaN counts as infinite).
+    fn record_peak(&mut self, fc: f64) {
+        self.peak_n = if fc.is_nan() { f64::INFINITY } else { self.peak_n.max(fc) };
+    }
+
+    /// Whether the last push limit ((b) → (c), or a stall) is at least `retry_interval_s` before `t` (or there was none).
     fn retry_spaced(&self, t: f64) -> bool {
         self.push_limit_s.is_nan() || t - self.push_limit_s >= self.dwell.retry_interval_s
     }
@@ -474,7 +504,8 @@ impl Supervisor {
             *d = Dwell::IDLE;
         }
         self.progress = Progress::IDLE;
-        self.hard_peak_n = 0.0;
+        self.last_strike_s = f64::NAN;
+        self.peak_n = 0.0;
         let tr = Transition { t_s: t, from, to, cause };
         self.last_transition = Some(tr);
         self.log.push(tr);

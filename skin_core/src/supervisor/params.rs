@@ -68,6 +68,9 @@ declare_params! {
         pub speed_band_mps: f64 => { unit: "m/s", range: Range::closed(0.0, 1.0), live: false },
         /// ε_c: hard contact when `‖F_c‖ ≥ ε_c`.
         pub contact_force_n: f64 => { unit: "N", range: Range::positive(1e3), live: false },
+        /// An impact: hard contact at once when `‖F_c‖ ≥` this, without `dwell.hard_contact_s`;
+        /// at least `contact_force_n`.
+        pub impact_force_n: f64 => { unit: "N", range: Range::positive(1e4), live: false },
         /// Hard contact is left only when `‖F_c‖ < ε_c − band`; below `contact_force_n` (else
         /// hard contact is never left).
         pub contact_band_n: f64 => { unit: "N", range: Range::closed(0.0, 1e3), live: false },
@@ -102,8 +105,12 @@ declare_params! {
     pub struct DwellTimes {
         /// (a) → (b): stopped near an obstacle with the goal not reached.
         pub stuck_s: f64 => { unit: "s", range: DWELL_S, live: false },
-        /// (a)/(b) → (c): contact force over ε_c (0: immediate).
+        /// (a)/(b) → (c): contact force over ε_c this long (0: immediate; at once from
+        /// `impact_force_n`), so one skin sample's peak of a rigid touch is no hard contact.
         pub hard_contact_s: f64 => { unit: "s", range: DWELL_S, live: false },
+        /// (a)/(b) → (c) at once: `‖F_c‖` rose to ε_c again within this long of its last rise
+        /// (a contact that keeps striking ε_c is hard, however short each strike; 0: off).
+        pub hard_contact_repeat_s: f64 => { unit: "s", range: DWELL_S, live: false },
         /// (c) → previous: contact force below ε_c − band.
         pub contact_release_s: f64 => { unit: "s", range: DWELL_S, live: false },
         /// (b) → (a): goal reached.
@@ -114,6 +121,9 @@ declare_params! {
         /// (c) → (b), unless the push before it also reached ε_c less than this long ago: at most
         /// two (b) → (c) in this long, so a retried push never chatters (`docs/supervisor.md`).
         pub retry_interval_s: f64 => { unit: "s", range: DWELL_S, live: false },
+        /// (b) → (a), blocked: the push got the goal less than `progress_min_m` nearer over this
+        /// long (it stalls, or vibrates under ε_c), as if it had reached ε_c without progress.
+        pub push_stall_s: f64 => { unit: "s", range: Range::positive(100.0), live: false },
     }
 }
 
@@ -239,6 +249,14 @@ impl SupervisorParams {
                 key: "thresholds.contact_band_n".into(),
                 value: t.contact_band_n,
                 reason: "must be < contact_force_n (else hard contact is never left)".into(),
+            }
+            .into());
+        }
+        if t.impact_force_n < t.contact_force_n {
+            return Err(InvalidParam {
+                key: "thresholds.impact_force_n".into(),
+                value: t.impact_force_n,
+                reason: "must be >= contact_force_n (an impact is a hard contact)".into(),
             }
             .into());
         }

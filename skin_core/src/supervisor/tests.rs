@@ -47,6 +47,11 @@ fn run(sup: &mut Supervisor, t: &mut f64, steps: usize, u: SupervisorInput) -> V
     out
 }
 
+/// Cycles a force over ε_c must last to be a hard contact (`dwell.hard_contact_s`).
+fn held(p: &SupervisorParams) -> usize {
+    (p.dwell.hard_contact_s / DT).ceil() as usize + 2 // + 2: t is summed from DT
+}
+
 fn stuck() -> SupervisorInput {
     input(0.0, 3.0, 0.0, 0.2)
 }
@@ -118,7 +123,7 @@ fn no_switch_to_b_when_moving_or_clear_or_at_goal() {
 fn contact_over_limit_in_b_goes_to_c_and_the_push_is_given_up() {
     let p = params();
     let (mut sup, mut t) = in_b(&p);
-    let tr = run(&mut sup, &mut t, 10, input(0.0, 0.0, 6.0, 0.2));
+    let tr = run(&mut sup, &mut t, held(&p), input(0.0, 0.0, 6.0, 0.2));
     assert_eq!(tr.len(), 1);
     assert_eq!((tr[0].from, tr[0].to), (Mode::IntentionalContact, Mode::HardContact));
     assert_eq!(tr[0].cause, Cause::ContactOverLimit);
@@ -127,10 +132,9 @@ fn contact_over_limit_in_b_goes_to_c_and_the_push_is_given_up() {
     // Below eps_c but inside the band: stays in (c).
     assert!(run(&mut sup, &mut t, 500, input(0.0, 0.0, 4.0, 0.2)).is_empty());
     assert_eq!(sup.blocked(), None);
-    // Below eps_c - band but still pressing: no (a) (Table I (a): no contact).
-    assert!(run(&mut sup, &mut t, 200, input(0.0, 3.0, 2.0, 0.2)).is_empty());
-    // The contact gone, for the dwell: the push of (b) reached eps_c, so back to (a), blocked.
-    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
+    // Below eps_c - band for the dwell: the push of (b) reached eps_c, so back to (a), blocked,
+    // where avoidance relieves the rest of the contact.
+    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 2.0, 0.2));
     assert_eq!(tr.len(), 1);
     assert_eq!((tr[0].from, tr[0].to, tr[0].cause), (Mode::HardContact, Mode::Avoidance, Cause::PushBlocked));
     let b = sup.blocked().expect("blocked");
@@ -148,7 +152,7 @@ fn a_push_that_made_progress_is_retried_once_per_interval() {
     let (mut sup, mut t) = in_b(&p);
     run(&mut sup, &mut t, 10, input(0.02, 0.0, 2.0, 0.2));
     assert!(!sup.releasing(), "(b) is no hard contact");
-    let tr = run(&mut sup, &mut t, 1, input(0.02, 0.0, 6.0, 0.2 - 2.0 * min));
+    let tr = run(&mut sup, &mut t, held(&p), input(0.02, 0.0, 6.0, 0.2 - 2.0 * min));
     assert_eq!((tr[0].to, tr[0].cause), (Mode::HardContact, Cause::ContactOverLimit));
     assert!(sup.releasing(), "a retried push's hard contact presses nothing either");
     let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
@@ -160,7 +164,7 @@ fn a_push_that_made_progress_is_retried_once_per_interval() {
     assert!(!sup.releasing(), "relieved, the retried push presses again in (b)");
     // Progress again, but 0.8 s after the last hard contact: given up.
     run(&mut sup, &mut t, 10, input(0.02, 0.0, 2.0, 0.2));
-    run(&mut sup, &mut t, 1, input(0.02, 0.0, 6.0, 0.2 - 4.0 * min));
+    run(&mut sup, &mut t, held(&p), input(0.02, 0.0, 6.0, 0.2 - 4.0 * min));
     assert!(sup.releasing(), "a push given up is released, not pressed again");
     let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
     assert_eq!(tr.last().map(|tr| tr.cause), Some(Cause::PushBlocked));
@@ -169,9 +173,60 @@ fn a_push_that_made_progress_is_retried_once_per_interval() {
     // No progress since the push began: blocked on the first hard contact.
     let (mut sup, mut t) = in_b(&p);
     run(&mut sup, &mut t, 10, input(0.02, 0.0, 2.0, 0.2));
-    run(&mut sup, &mut t, 1, input(0.0, 0.0, 6.0, 0.2 - 0.5 * min));
+    run(&mut sup, &mut t, held(&p), input(0.0, 0.0, 6.0, 0.2 - 0.5 * min));
     let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
     assert_eq!(tr.last().map(|tr| tr.cause), Some(Cause::PushBlocked));
+}
+
+/// `‖F_c‖ ≥ ε_c` is a hard contact when it lasts `hard_contact_s`, when it strikes ε_c again
+/// within `hard_contact_repeat_s` of its last strike, or at once from `impact_force_n`; one
+/// strike shorter than the dwell (a rigid touch's peak) is none.
+#[test]
+fn a_hard_contact_lasts_strikes_again_or_is_an_impact() {
+    let p = params();
+    let (th, dw) = (p.thresholds, p.dwell);
+    let strike = input(0.02, 3.0, th.contact_force_n + 0.5, 0.2);
+    let light = input(0.02, 3.0, 2.0, 0.2);
+    let (mut sup, mut t) = in_b(&p);
+    assert!(run(&mut sup, &mut t, held(&p) - 4, strike).is_empty(), "shorter than the dwell");
+    let apart = (dw.hard_contact_repeat_s / DT) as usize + 2;
+    assert!(run(&mut sup, &mut t, apart, light).is_empty());
+    assert!(run(&mut sup, &mut t, 1, strike).is_empty(), "a strike more than repeat_s after the last");
+    run(&mut sup, &mut t, 10, light);
+    let tr = run(&mut sup, &mut t, 1, strike);
+    let to: Vec<_> = tr.iter().map(|tr| (tr.to, tr.cause)).collect();
+    assert_eq!(to, [(Mode::HardContact, Cause::ContactOverLimit)], "struck again within repeat_s");
+
+    let (mut sup, mut t) = in_b(&p);
+    assert_eq!(run(&mut sup, &mut t, 1, input(0.02, 0.0, th.impact_force_n, 0.2)).len(), 1);
+    assert_eq!(sup.mode(), Mode::HardContact, "an impact, at once");
+}
+
+/// A push in (b) that gets the goal less than `progress_min_m` nearer in `push_stall_s` (it
+/// stalls, or its contact flickers under the hard-contact rules) is given up as one that reached
+/// ε_c: (a), held, pressing nothing; a push that gains on the goal slowly goes on.
+#[test]
+fn a_push_that_gets_nowhere_is_given_up() {
+    let p = params();
+    let (th, dw) = (p.thresholds, p.dwell);
+    let (mut sup, mut t) = in_b(&p);
+    let steps = ((dw.push_stall_s + 0.6) / DT) as usize;
+    let tr = run(&mut sup, &mut t, steps, input(0.0, 3.0, 3.0, 0.2));
+    let to: Vec<_> = tr.iter().map(|tr| (tr.from, tr.to, tr.cause)).collect();
+    assert_eq!(to, [(Mode::IntentionalContact, Mode::Avoidance, Cause::PushStalled)]);
+    let b = sup.blocked().expect("held");
+    assert_eq!((b.goal_error_m, b.contact_force_n), (0.2, 3.0));
+    assert!(sup.releasing());
+    assert!(run(&mut sup, &mut t, 2000, stuck()).is_empty(), "no second push while held");
+
+    let (mut sup, mut t) = in_b(&p);
+    let t0 = t;
+    let rate = 1.2 * th.progress_min_m / dw.push_stall_s;
+    for _ in 0..(4.0 * dw.push_stall_s / DT) as usize {
+        t += DT;
+        sup.update(t, &input(0.01, 3.0, 3.0, 0.2 - rate * (t - t0)));
+        assert_eq!(sup.last_transition(), None, "a slow push that gains on the goal goes on");
+    }
 }
 
 /// Against a fixed obstacle the arm is stuck again right after backing off: while blocked the
@@ -198,7 +253,7 @@ fn blocked_ends_on_goal_progress_or_nothing_in_range() {
     let p = params();
     let blocked = || {
         let (mut sup, mut t) = in_b(&p);
-        run(&mut sup, &mut t, 10, input(0.0, 3.0, 8.0, 0.2));
+        run(&mut sup, &mut t, held(&p), input(0.0, 3.0, 8.0, 0.2));
         run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
         assert!(sup.blocked().is_some());
         // Within `retry_interval_s` of the hard contact nothing ends the hold (the arm backing
@@ -223,7 +278,7 @@ fn blocked_ends_on_goal_progress_or_nothing_in_range() {
     assert_eq!(sup.blocked(), None);
 
     let (mut sup, mut t) = blocked();
-    let tr = run(&mut sup, &mut t, 10, input(0.0, 3.0, 9.0, 0.2));
+    let tr = run(&mut sup, &mut t, held(&p), input(0.0, 3.0, 9.0, 0.2));
     assert_eq!((tr[0].from, tr[0].to), (Mode::Avoidance, Mode::HardContact));
     let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2));
     assert_eq!((tr[0].to, tr[0].cause), (Mode::Avoidance, Cause::ContactReleased));
@@ -235,7 +290,7 @@ fn hard_contact_from_a_returns_to_a() {
     let p = params();
     let mut sup = Supervisor::new(&p, 0.0).unwrap();
     let mut t = 0.0;
-    let tr = run(&mut sup, &mut t, 1, input(0.1, 0.0, 5.0, 0.2));
+    let tr = run(&mut sup, &mut t, held(&p), input(0.1, 0.0, 5.0, 0.2));
     assert_eq!((tr[0].from, tr[0].to), (Mode::Avoidance, Mode::HardContact));
     let tr = run(&mut sup, &mut t, 200, input(0.1, 0.0, 0.0, 0.2));
     assert_eq!((tr[0].from, tr[0].to), (Mode::HardContact, Mode::Avoidance));
@@ -249,7 +304,7 @@ fn hard_contact_is_left_for_a_only_without_contact() {
     let th = p.thresholds;
     let mut sup = Supervisor::new(&p, 0.0).unwrap();
     let mut t = 0.0;
-    run(&mut sup, &mut t, 1, input(0.1, 0.0, th.contact_force_n, 0.2));
+    run(&mut sup, &mut t, held(&p), input(0.1, 0.0, th.contact_force_n, 0.2));
     assert_eq!(sup.mode(), Mode::HardContact);
     let pressing = 0.5 * (th.contact_zero_n + th.contact_force_n - th.contact_band_n);
     assert!(run(&mut sup, &mut t, 500, input(0.1, 0.0, pressing, 0.2)).is_empty(), "still in contact");
@@ -292,12 +347,14 @@ fn sensing_range_shrinks_gradually_in_b_and_is_restored_in_a() {
     let (mut sup, mut t) = in_b(&p);
     let mut prev = sup.arrangement().sensing_range_m;
     let mut hit_zero_at = None;
-    for _ in 0..1000 {
+    let stall_s = sup.arrangement().switch_time_s + p.dwell.push_stall_s; // the push gets nowhere here
+    while t + DT < stall_s - 0.05 {
         t += DT;
-        let a = sup.update(t, &stuck());
-        let d = prev - a.sensing_range_m;
+        let range = sup.update(t, &stuck()).sensing_range_m;
+        assert_eq!(sup.last_transition(), None);
+        let d = prev - range;
         assert!((-1e-15..=r.shrink_rate_mps * DT + 1e-12).contains(&d), "step {d}");
-        prev = a.sensing_range_m;
+        prev = range;
         if prev == r.intentional_contact_m && hit_zero_at.is_none() {
             hit_zero_at = Some(t);
         }
@@ -327,14 +384,15 @@ fn noise_around_thresholds_does_not_chatter() {
     let n = 5000;
     let mut rng = Rng(42);
 
-    // Speed around eps_v in (a), obstacle in range, goal far: at most the one (a) -> (b).
+    // Speed around eps_v in (a), obstacle in range, goal far (nearing at 5 mm/s, so that the push
+    // is no stall): at most the one (a) -> (b).
     let mut sup = Supervisor::new(&p, 0.0).unwrap();
     let mut t = 0.0;
     let mut count = 0;
     for _ in 0..n {
         t += DT;
         let v = th.speed_mps * (1.0 + 0.2 * rng.next());
-        sup.update(t, &input(v, 3.0, 0.0, 0.2));
+        sup.update(t, &input(v, 3.0, 0.0, 0.2 - 0.005 * t));
         count += sup.last_transition().is_some() as usize;
     }
     assert!(count <= 1, "speed noise: {count}");
@@ -370,14 +428,15 @@ fn noise_around_thresholds_does_not_chatter() {
     }
     assert!(sup.log().total() - base <= 1, "goal noise");
 
-    // Obstacle force around the in-range level in (a) while stopped: at most one (a) -> (b).
+    // Obstacle force around the in-range level in (a) while stopped (the goal nearing at 5 mm/s,
+    // no stall): at most one (a) -> (b).
     let mut sup = Supervisor::new(&p, 0.0).unwrap();
     let mut t = 0.0;
     let level = th.obstacle_force_n + th.obstacle_band_n;
     for _ in 0..n {
         t += DT;
         let fd = level * (1.0 + 0.2 * rng.next());
-        sup.update(t, &input(0.0, fd, 0.0, 0.2));
+        sup.update(t, &input(0.0, fd, 0.0, 0.2 - 0.005 * t));
     }
     assert!(sup.log().total() <= 1, "obstacle noise");
 }
@@ -494,7 +553,7 @@ fn switching_does_not_reallocate_task_order() {
     let ptr = sup.arrangement().task_order().as_ptr();
     let mut t = 0.0;
     into_b(&mut sup, &mut t);
-    run(&mut sup, &mut t, 10, input(0.0, 3.0, 9.0, 0.2));
+    run(&mut sup, &mut t, held(&p), input(0.0, 3.0, 9.0, 0.2));
     assert_eq!(sup.mode(), Mode::HardContact);
     assert_eq!(sup.arrangement().task_order().as_ptr(), ptr);
 }
@@ -504,7 +563,7 @@ fn log_ring_buffer_keeps_latest() {
     let mut p = params();
     p.log_capacity = 2;
     let (mut sup, mut t) = in_b(&p); // a -> b
-    run(&mut sup, &mut t, 1, input(0.0, 3.0, 9.0, 0.2)); // b -> c
+    run(&mut sup, &mut t, held(&p), input(0.0, 3.0, 9.0, 0.2)); // b -> c
     run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 0.2)); // c -> a (push given up)
     assert_eq!(sup.log().total(), 3);
     let kept: Vec<(Mode, Mode)> = sup.log().iter().map(|t| (t.from, t.to)).collect();
@@ -677,6 +736,8 @@ fn other_invalid_values_are_rejected() {
         ("w_contact: 1.0", "w_contact: 1.5", "fusion.w_contact"),
         ("stuck_s: 0.5", "stuck_s: -0.5", "dwell.stuck_s"),
         ("log_capacity: 64", "log_capacity: 0", "log_capacity"),
+        ("impact_force_n: 10.0", "impact_force_n: 4.0", "thresholds.impact_force_n"),
+        ("push_stall_s: 3.0", "push_stall_s: 0.0", "dwell.push_stall_s"),
     ] {
         let e = load_err(old, new);
         assert!(e.contains("bad.yaml") && e.contains(key), "{e}");

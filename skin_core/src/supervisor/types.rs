@@ -84,7 +84,8 @@ pub struct SupervisorInput {
     /// largest one) \[N\], computed with the NOMINAL sensing range
     /// (otherwise shrinking the range in (b) would itself read as "nothing in range").
     pub avoidance_force_n: f64,
-    /// `‖F_c‖`, the largest skin contact force \[N\].
+    /// `‖F_c‖`, the largest contact force on one link: the norm of the sum of its cells'
+    /// measured forces along their normals \[N\].
     pub contact_force_n: f64,
     /// Distance of the end effector to its goal \[m\].
     pub goal_error_m: f64,
@@ -103,6 +104,9 @@ pub enum Cause {
     /// from intentional contact (b): the push cannot succeed under ε_c, so the arm goes back to
     /// (a) (backs off) and intentional contact stays off while [`Blocked`] holds.
     PushBlocked,
+    /// The push of intentional contact (b) got the goal less than `progress_min_m` nearer in
+    /// `dwell.push_stall_s`: given up as [`Cause::PushBlocked`] gives it up, without a hard contact.
+    PushStalled,
     /// Goal reached during intentional contact.
     GoalReached,
     /// No obstacle in the nominal range any more.
@@ -123,11 +127,12 @@ pub enum Cause {
 /// `dwell.clear_s`; until then the stuck test (a) → (b) is off (`docs/supervisor.md`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Blocked {
-    /// When the push was given up (the (c) → (a) switch) \[s\].
+    /// When the push was given up (the (c) → (a) or the stalled (b) → (a) switch) \[s\].
     pub since_s: f64,
     /// The goal error then \[m\].
     pub goal_error_m: f64,
-    /// The largest contact force `‖F_c‖` of the hard contact that blocked the push \[N\].
+    /// The largest contact force `‖F_c‖` of the hard contact that blocked the push, or of the
+    /// stalled push \[N\].
     pub contact_force_n: f64,
 }
 

@@ -39,8 +39,11 @@ pub struct ContactSummary {
     pub rows: usize,
     /// Largest task force `F_ci = gain · F_i` \[N\].
     pub max_force_n: f64,
-    /// Largest measured cell force `F_i` \[N\]: the supervisor's `‖F_c‖` (Table I).
-    pub max_measured_n: f64,
+    /// The supervisor's `‖F_c‖` (Table I): the largest contact force on one link \[N\], the
+    /// norm of the sum of its cells' measured forces `F_i (−n_i)`. A contact shared by cells
+    /// presses its link with their sum; the largest single cell read 4.3 N where the link
+    /// carried 6 N.
+    pub max_link_n: f64,
 }
 
 impl ContactReaction {
@@ -79,6 +82,28 @@ impl ContactReaction {
     }
 }
 
+/// The largest norm over the links of the sum of their cells' measured forces along the
+/// outward normals (link frame; the sign does not change the norm) \[N\].
+fn max_link_force_n(layout: &ResolvedLayout, cells: &LiveCells, force: &PreparedForce, fusion: &FusionParams) -> f64 {
+    let patches = layout.patches();
+    let mut max = 0.0_f64;
+    for (j, patch) in patches.iter().enumerate() {
+        if patches[..j].iter().any(|p| p.frame == patch.frame) {
+            continue; // the link was summed at its first patch
+        }
+        let mut sum = nalgebra::Vector3::zeros();
+        for p in patches[j..].iter().filter(|p| p.frame == patch.frame) {
+            for (i, reading) in cells.in_range(p.cells.clone()) {
+                if let Some(f) = fusion.cell_force_n(reading, force) {
+                    sum += layout.cells()[*i].normal_link * f;
+                }
+            }
+        }
+        max = max.max(sum.norm());
+    }
+    max
+}
+
 impl ContactReactionParams {
     /// Calls `row(cell, (F_ci, a_i))` for every cell in contact (eq. 6) and sums them up; `a_i`
     /// rises with the measured force up to `activation_force_n`. Only the non-silent cells can
@@ -101,7 +126,9 @@ impl ContactReactionParams {
             row(&layout.cells()[*i], (f, row_activation(measured, self.activation_force_n)))?;
             s.rows += 1;
             s.max_force_n = s.max_force_n.max(f);
-            s.max_measured_n = s.max_measured_n.max(measured);
+        }
+        if s.rows > 0 {
+            s.max_link_n = max_link_force_n(layout, cells, force, fusion);
         }
         Ok(s)
     }

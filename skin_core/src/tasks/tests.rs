@@ -231,6 +231,29 @@ fn contact_reaction_moves_touched_cell_along_minus_n() {
     assert!((j.fixed_rows::<3>(0) * qdd).dot(&nw) < 0.0);
 }
 
+/// Table I's `‖F_c‖` is the force on a link, not on one cell: two pressed cells of one link add
+/// as vectors along their normals, a pressed cell of another link does not add to them.
+#[test]
+fn contact_force_is_the_largest_link_force_summed_over_its_cells() {
+    let s = tomm();
+    let n = s.layout.num_cells();
+    let forearm = s.layout.patches()[patch_of(&s.layout, "right_forearm_link")].cells.start;
+    let upper = s.layout.patches()[patch_of(&s.layout, "right_upper_arm_link")].cells.start;
+    let (a, b) = (forearm + 3, forearm + 4);
+    let mut readings = vec![CellReading::uniform(0.0, 0.0); n];
+    for c in [a, b, upper] {
+        readings[c] = CellReading::uniform(0.5, 1.0);
+    }
+    let task = ContactReaction::new(s.model.nv(), s.params.contact_reaction, &s.skin.force);
+    let live = LiveCells::from_readings(&readings, &s.skin.proximity);
+    let sum = task.summarize(&s.layout, &live, &s.skin.fusion).unwrap();
+    let f = s.skin.force.force_n(0.5);
+    let cells = s.layout.cells();
+    let forearm_n = (cells[a].normal_link + cells[b].normal_link).norm() * f;
+    assert!(forearm_n > 1.5 * f, "neighbouring cells face nearly the same way");
+    assert_relative_eq!(sum.max_link_n, forearm_n, epsilon = 1e-9);
+}
+
 /// The closing speed bound of the hand task: a hand moving into a surface faster than
 /// `v_0 + d / T_a` brakes whatever eq. (9) asks for, the bound falls with the sensed distance, and
 /// a hand slower than it gets eq. (9) unchanged.

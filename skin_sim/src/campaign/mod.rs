@@ -61,6 +61,14 @@ pub fn scene(seed: u64, id: usize) -> Result<CampaignScene, String> {
     Ok(CampaignScene { id, family, drawn, resistance_n, feasible, target, spec })
 }
 
+impl CampaignScene {
+    /// The same scene with another controller setup file (a changed controller measured on it).
+    pub fn with_controller(mut self, controller: PathBuf) -> Self {
+        self.target.controller = controller;
+        self
+    }
+}
+
 /// Runs `s`; `out`: also write the run's own outputs there.
 pub fn run_scene(s: &CampaignScene, out: Option<&Path>) -> SceneResult {
     let start = Instant::now();

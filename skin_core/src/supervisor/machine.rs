@@ -413,7 +413,8 @@ impl Supervisor {
             Mode::HardContact => {
                 self.record_peak(fc);
                 // Back to (b) when the force is below ε_c − band (Table I (b): `‖F_c‖ < ε_c`);
-                // back to (a) only when the contact is gone (Table I (a): `‖F_c‖ = 0`).
+                // a hard contact of (a) back to (a) only when the contact is gone (Table I (a):
+                // `‖F_c‖ = 0`).
                 let to_b = self.resume == Mode::IntentionalContact && self.retry;
                 // A push given up is released into (a) below the band too: avoidance, first
                 // there, relieves the rest of the contact.
@@ -481,7 +482,8 @@ impl Supervisor {
         self.peak_n = if fc.is_nan() { f64::INFINITY } else { self.peak_n.max(fc) };
     }
 
-    /// Whether the last push limit ((b) → (c), or a stall) is at least `retry_interval_s` before `t` (or there was none).
+    /// Whether the last push limit ((b) → (c), or a stall) is at least `retry_interval_s`
+    /// before `t` (or there was none).
     fn retry_spaced(&self, t: f64) -> bool {
         self.push_limit_s.is_nan() || t - self.push_limit_s >= self.dwell.retry_interval_s
     }

@@ -314,7 +314,7 @@ fn tasks_do_not_allocate_after_setup() {
     let mut goal = GoalPosition::new(nv, hand, Vector3::zeros(), p.goal);
     let mut orient = GoalOrientation::new(nv, hand, p.goal_orientation);
     let mut avoid = ProximityAvoidance::new(nv, p.avoidance);
-    let mut contact = ContactReaction::new(nv, p.contact_reaction, &skin.force);
+    let mut contact = ContactReaction::new(nv, model.nframes(), p.contact_reaction, &skin.force);
     let mut hand_task = HandForce::new(nv, hand, p.hand_force);
     let mut wrist = CompliantWrist::new(nv, hand, p.wrist);
     let mut guide = TactileGuidance::new(nv, hand, p.tactile_guidance);

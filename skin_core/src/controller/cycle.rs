@@ -192,7 +192,12 @@ impl Controller {
             clock: StageClock::default(),
             tasks,
             proximity_signal: ProximityAvoidance::new(nv, config.tasks.avoidance),
-            contact_signal: ContactReaction::new(nv, config.tasks.contact_reaction, &config.skin.force),
+            contact_signal: ContactReaction::new(
+                nv,
+                config.model.nframes(),
+                config.tasks.contact_reaction,
+                &config.skin.force,
+            ),
             hand_force_reference_n: config.tasks.hand_force.force_desired_n,
             force: config.skin.force.prepared(),
             base_reference: None,
@@ -517,7 +522,7 @@ impl Controller {
 
     /// The supervisor's inputs: `‖F_d‖` at the nominal range, the largest contact force, the
     /// end-effector speed and goal error (task summaries only: no rows are built here).
-    fn signals(&self) -> Result<SupervisorInput, Fault> {
+    fn signals(&mut self) -> Result<SupervisorInput, Fault> {
         let (model, data, config) = (&self.config.model, &self.data, &self.config);
         let (skin, layout) = (&config.skin, &config.layout);
         let nominal = config.supervisor.sensing_range.nominal_m;

@@ -10,6 +10,8 @@
 //! characteristic of the cell's force signal, for cells above the activity threshold. A row's
 //! activation in the null-space projector rises smoothly with `F_i` (`activation_force_n`).
 
+use nalgebra::Vector3;
+
 use super::error::TaskError;
 use super::params::ContactReactionParams;
 use super::point_rows::{push_inward_cell_row, row_activation};
@@ -30,6 +32,8 @@ pub struct ContactReaction {
     force: PreparedForce,
     /// Scratch: one cell's Jacobian row.
     row: Vec<f64>,
+    /// Scratch per model frame: the sum of its cells' measured forces along their normals.
+    link_force: Vec<Vector3<f64>>,
 }
 
 /// Summary of one contact-reaction update, for the supervisor.
@@ -47,10 +51,10 @@ pub struct ContactSummary {
 }
 
 impl ContactReaction {
-    /// The task for a model with `nv` joints and cells with the force characteristic `force`;
-    /// its level needs `layout.num_cells()` rows.
-    pub fn new(nv: usize, params: ContactReactionParams, force: &ForceCharacteristic) -> Self {
-        Self { params, force: force.prepared(), row: vec![0.0; nv] }
+    /// The task for a model with `nv` joints and `nframes` frames and cells with the force
+    /// characteristic `force`; its level needs `layout.num_cells()` rows.
+    pub fn new(nv: usize, nframes: usize, params: ContactReactionParams, force: &ForceCharacteristic) -> Self {
+        Self { params, force: force.prepared(), row: vec![0.0; nv], link_force: vec![Vector3::zeros(); nframes] }
     }
 
     /// Fills `level` (force rows) from the non-silent cells of this cycle's readings.
@@ -66,70 +70,51 @@ impl ContactReaction {
     ) -> Result<ContactSummary, TaskError> {
         level.clear();
         let row = &mut self.row;
-        self.params.contact_cells(layout, cells, &self.force, fusion, |cell, fa| {
+        self.params.contact_cells(layout, cells, &self.force, fusion, &mut self.link_force, |cell, fa| {
             push_inward_cell_row(model, data, cell, fa, row, level)
         })
     }
 
     /// The summary [`Self::update`] would return, without the rows (no Jacobians).
     pub fn summarize(
-        &self,
+        &mut self,
         layout: &ResolvedLayout,
         cells: &LiveCells,
         fusion: &FusionParams,
     ) -> Result<ContactSummary, TaskError> {
-        self.params.contact_cells(layout, cells, &self.force, fusion, |_, _| Ok(()))
+        self.params.contact_cells(layout, cells, &self.force, fusion, &mut self.link_force, |_, _| Ok(()))
     }
-}
-
-/// The largest norm over the links of the sum of their cells' measured forces along the
-/// outward normals (link frame; the sign does not change the norm) \[N\].
-fn max_link_force_n(layout: &ResolvedLayout, cells: &LiveCells, force: &PreparedForce, fusion: &FusionParams) -> f64 {
-    let patches = layout.patches();
-    let mut max = 0.0_f64;
-    for (j, patch) in patches.iter().enumerate() {
-        if patches[..j].iter().any(|p| p.frame == patch.frame) {
-            continue; // the link was summed at its first patch
-        }
-        let mut sum = nalgebra::Vector3::zeros();
-        for p in patches[j..].iter().filter(|p| p.frame == patch.frame) {
-            for (i, reading) in cells.in_range(p.cells.clone()) {
-                if let Some(f) = fusion.cell_force_n(reading, force) {
-                    sum += layout.cells()[*i].normal_link * f;
-                }
-            }
-        }
-        max = max.max(sum.norm());
-    }
-    max
 }
 
 impl ContactReactionParams {
     /// Calls `row(cell, (F_ci, a_i))` for every cell in contact (eq. 6) and sums them up; `a_i`
     /// rises with the measured force up to `activation_force_n`. Only the non-silent cells can
-    /// be in contact (a silent cell's force signal is 0).
+    /// be in contact (a silent cell's force signal is 0). `link_force` (one per model frame) is
+    /// scratch for the links' summed forces, in the same pass.
     fn contact_cells(
         &self,
         layout: &ResolvedLayout,
         cells: &LiveCells,
         force: &PreparedForce,
         fusion: &FusionParams,
+        link_force: &mut [Vector3<f64>],
         mut row: impl FnMut(&ResolvedCell, (f64, f64)) -> Result<(), TaskError>,
     ) -> Result<ContactSummary, TaskError> {
         LengthMismatch::check_count(layout, cells.num_cells())?;
         let mut s = ContactSummary::default();
+        link_force.fill(Vector3::zeros());
         for (i, reading) in cells.cells() {
             let Some(measured) = fusion.cell_force_n(reading, force) else {
                 continue;
             };
+            let cell = &layout.cells()[*i];
             let f = self.gain * measured;
-            row(&layout.cells()[*i], (f, row_activation(measured, self.activation_force_n)))?;
+            row(cell, (f, row_activation(measured, self.activation_force_n)))?;
             s.rows += 1;
             s.max_force_n = s.max_force_n.max(f);
+            link_force[cell.frame] += cell.normal_link * measured; // link frame: the sign does not change the norm
         }
-        if s.rows > 0 {
-            s.max_link_n = max_link_force_n(layout, cells, force, fusion);
-        }
+        s.max_link_n = link_force.iter().map(|f| f.norm()).fold(0.0, f64::max);
         Ok(s)
     }
 }
@@ -144,7 +129,7 @@ impl Task for ContactReaction {
     }
 
     fn build(s: &TaskSetup) -> Result<Self, TaskError> {
-        Ok(Self::new(s.model.nv(), s.params.contact_reaction, &s.skin.force))
+        Ok(Self::new(s.model.nv(), s.model.nframes(), s.params.contact_reaction, &s.skin.force))
     }
 
     fn fill(&mut self, cx: &Cycle, level: &mut TaskLevel) -> Result<(), TaskError> {

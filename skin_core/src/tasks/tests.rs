@@ -207,7 +207,7 @@ fn contact_reaction_moves_touched_cell_along_minus_n() {
     let c = s.layout.patches()[forearm].cells.start + 3;
     let mut readings = vec![CellReading::uniform(0.0, 0.0); n];
     readings[c] = CellReading::uniform(0.5, 1.0);
-    let mut task = ContactReaction::new(s.model.nv(), s.params.contact_reaction, &s.skin.force);
+    let mut task = ContactReaction::new(s.model.nv(), s.model.nframes(), s.params.contact_reaction, &s.skin.force);
     let mut level = TaskLevel::new("contact", s.model.nv(), n);
     let sum = task
         .update(
@@ -244,7 +244,7 @@ fn contact_force_is_the_largest_link_force_summed_over_its_cells() {
     for c in [a, b, upper] {
         readings[c] = CellReading::uniform(0.5, 1.0);
     }
-    let task = ContactReaction::new(s.model.nv(), s.params.contact_reaction, &s.skin.force);
+    let mut task = ContactReaction::new(s.model.nv(), s.model.nframes(), s.params.contact_reaction, &s.skin.force);
     let live = LiveCells::from_readings(&readings, &s.skin.proximity);
     let sum = task.summarize(&s.layout, &live, &s.skin.fusion).unwrap();
     let f = s.skin.force.force_n(0.5);

@@ -100,15 +100,20 @@ def store():
 
 
 def plain(v):
-    """A message as nested dicts and lists of Python numbers and strings, for exact comparison."""
+    """A message as nested dicts and lists of Python numbers and strings, for exact comparison
+    (a NaN as the string "NaN": NaN equals nothing, not even itself)."""
+    import math
+
     import numpy as np
 
     if hasattr(v, "__dataclass_fields__"):
         return {k: plain(getattr(v, k)) for k in v.__dataclass_fields__ if k != "__msgtype__"}
     if isinstance(v, np.ndarray):
-        return v.tolist()
+        return plain(v.tolist()) if v.dtype.kind == "f" and np.isnan(v).any() else v.tolist()
     if isinstance(v, (list, tuple)):
         return [plain(x) for x in v]
+    if isinstance(v, float) and math.isnan(v):
+        return "NaN"
     return v
 
 

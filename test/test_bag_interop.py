@@ -79,7 +79,7 @@ def expected(ts):
                 contact_force=5.5))),
         ("/controller/state", 10 * S, T["skin_msgs/msg/ControllerState"](
             header=header(10, ""), mode=2, blend=0.3, ee_speed=0.012, avoidance_force=1.5,
-            contact_force=12.5, torque_norm=42.0, goal_error=-1.0, releasing=True,
+            contact_force=12.5, contact_advance=0.004, torque_norm=42.0, goal_error=-1.0, releasing=True,
             blocked=T["skin_msgs/msg/BlockedHold"](
                 active=False, since=Time(sec=0, nanosec=0), goal_error=0.0, contact_force=0.0),
             goal_count=3, tasks=[

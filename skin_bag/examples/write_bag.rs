@@ -160,6 +160,7 @@ fn samples(v: &mut impl Visit) -> Result<()> {
             ee_speed: 0.012,
             avoidance_force: 1.5,
             contact_force: 12.5,
+            contact_advance: 0.004,
             torque_norm: 42.0,
             goal_error: -1.0,
             releasing: true,

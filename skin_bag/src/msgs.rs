@@ -352,6 +352,8 @@ pub struct ControllerState {
     pub avoidance_force: f64,
     /// Largest contact force \[N\].
     pub contact_force: f64,
+    /// Speed at which the link pressed hardest moves into its contact \[m/s\], NaN without.
+    pub contact_advance: f64,
     /// Commanded torque norm \[N m\].
     pub torque_norm: f64,
     /// Distance to the goal \[m\], negative without goal.

@@ -24,6 +24,7 @@ fn bench_update(c: &mut Criterion) {
                 avoidance_force_n: 3.0,
                 contact_force_n: if (0.4..0.5).contains(&s) { 8.0 } else { 0.0 },
                 goal_error_m: if s < 0.8 { 0.2 } else { 0.0 },
+                contact_advance_mps: f64::NAN,
             }
         })
         .collect();

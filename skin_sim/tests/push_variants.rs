@@ -109,17 +109,12 @@ fn the_shipped_movable_obstacle_is_still_pushed_to_the_goal() {
     assert!(goal.reached_before_pushes(), "by the push at 15 s: {} m before it", goal.goal_error_before_pushes_m);
 }
 
-/// A controller setup in `dir` that is the shipped planar7 one with `contact_reaction` removed
-/// from the three Table I arrangements.
-fn setup_without_contact_reaction(dir: &std::path::Path) -> std::path::PathBuf {
+/// A controller setup in `dir` that is the shipped planar7 one with `config/supervisor.yaml`'s
+/// text changed by `changes` (each `(from, to)`, `from` must be there).
+fn setup_with_supervisor(dir: &std::path::Path, changes: &[(&str, &str)]) -> std::path::PathBuf {
     let config = skin_sim::scene::config_dir();
-    let shipped = std::fs::read_to_string(config.join("supervisor.yaml")).unwrap();
-    let mut supervisor = shipped.clone();
-    for (from, to) in [
-        ("avoidance: [avoidance, goal, contact_reaction]", "avoidance: [avoidance, goal]"),
-        ("intentional_contact: [goal, contact_reaction, avoidance]", "intentional_contact: [goal, avoidance]"),
-        ("hard_contact: [contact_reaction, goal, avoidance]", "hard_contact: [goal, avoidance]"),
-    ] {
+    let mut supervisor = std::fs::read_to_string(config.join("supervisor.yaml")).unwrap();
+    for (from, to) in changes {
         assert!(supervisor.contains(from), "config/supervisor.yaml has `{from}`");
         supervisor = supervisor.replace(from, to);
     }
@@ -152,8 +147,37 @@ fn removing_contact_reaction_leaves_a_shove_on_the_arm_pressed() {
 
     let dir = std::env::temp_dir().join(format!("skin_sim_no_reaction_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let without = skin_sim::campaign::scene(1, 176).unwrap().with_controller(setup_without_contact_reaction(&dir));
+    let no_reaction = [
+        ("avoidance: [avoidance, goal, contact_reaction]", "avoidance: [avoidance, goal]"),
+        ("intentional_contact: [goal, contact_reaction, avoidance]", "intentional_contact: [goal, avoidance]"),
+        ("hard_contact: [contact_reaction, goal, avoidance]", "hard_contact: [goal, avoidance]"),
+    ];
+    let without = skin_sim::campaign::scene(1, 176).unwrap().with_controller(setup_with_supervisor(&dir, &no_reaction));
     let v = verdict(skin_sim::campaign::run_scene(&without, None));
     std::fs::remove_dir_all(&dir).unwrap();
     assert!(v.violations.iter().any(|v| v.starts_with("contact over eps_c")), "without: {:?}", v.violations);
+}
+
+/// A push through the stick-slip peaks of an obstacle that slides (`docs/supervisor.md`, "Strikes
+/// of a push that gives way"): in campaign planar seed 1 scene 88 (2.5 kg, 3.2 N of friction)
+/// the pressed link's force strikes eps_c again and again within `hard_contact_repeat_s`, each
+/// strike a skin sample or two, while the link advances into the obstacle. The push goes on and
+/// reaches the goal before the scripted shove; told that no contact gives way
+/// (`give_way_speed_mps` out of reach), the supervisor takes the strikes for a hard contact and
+/// gives the push up.
+#[test]
+fn strikes_of_an_obstacle_that_slides_do_not_end_the_push() {
+    let scene = skin_sim::campaign::scene(1, 88).unwrap();
+    assert!(scene.feasible, "the obstacle slides under eps_c");
+    let verdict = |r: skin_sim::campaign::SceneResult| r.verdict.expect("the scene runs");
+    let v = verdict(skin_sim::campaign::run_scene(&scene, None));
+    assert!(v.violations.is_empty() && v.goal_reached == Some(true), "shipped: {v:?}");
+
+    let dir = std::env::temp_dir().join(format!("skin_sim_no_give_way_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rigid = [("give_way_speed_mps: 0.005", "give_way_speed_mps: 1.0")];
+    let rigid = skin_sim::campaign::scene(1, 88).unwrap().with_controller(setup_with_supervisor(&dir, &rigid));
+    let v = verdict(skin_sim::campaign::run_scene(&rigid, None));
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(v.goal_reached, Some(false), "every strike a hard contact: {v:?}");
 }

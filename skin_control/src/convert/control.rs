@@ -144,6 +144,7 @@ pub fn write_controller_state(
     msg.ee_speed = out.signals.ee_speed_mps;
     msg.avoidance_force = out.signals.avoidance_force_n;
     msg.contact_force = out.signals.contact_force_n;
+    msg.contact_advance = out.signals.contact_advance_mps;
     msg.torque_norm = out.torque_norm;
     let ge = out.signals.goal_error_m;
     msg.goal_error = if ge.is_nan() { -1.0 } else { ge };
@@ -182,6 +183,7 @@ pub fn supervisor_input(msg: &ControllerState) -> (f64, skin_core::supervisor::S
             avoidance_force_n: msg.avoidance_force,
             contact_force_n: msg.contact_force,
             goal_error_m: ge,
+            contact_advance_mps: msg.contact_advance,
         },
     )
 }

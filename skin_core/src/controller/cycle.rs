@@ -532,6 +532,13 @@ impl Controller {
         let speed = point_velocity(model, data, self.ee, &nalgebra::Vector3::zeros())
             .map_err(stage("end-effector velocity"))?
             .norm();
+        let advance = match contact.pressed {
+            Some(c) => {
+                let v = point_velocity(model, data, c.frame, &c.point).map_err(stage("contact advance"))?;
+                (data.frame_pose(c.frame).rotation * c.force.normalize()).dot(&v)
+            }
+            None => f64::NAN,
+        };
         let goal_error = self
             .goal
             .as_ref()
@@ -541,6 +548,7 @@ impl Controller {
             avoidance_force_n: avoid.force_norm_n,
             contact_force_n: contact.max_link_n,
             goal_error_m: goal_error,
+            contact_advance_mps: advance,
         })
     }
 

@@ -473,3 +473,32 @@ fn a_link_pushing_what_gives_way_pushes_faster_than_it_touches() {
     assert_eq!(step(push_n, ContactIntent::Release), (0.0, 0.0, 0.0), "releasing: nothing closes");
     assert_eq!(step(th.contact_force_n, ContactIntent::Push).0, 0.0, "no cell is pushed into eps_c");
 }
+
+/// The supervisor's `contact_advance_mps`: the point where the link pressed hardest is pressed,
+/// moving along the link's force: as fast as a lone pressed cell closes on what it touches,
+/// negative when it backs away, NaN without contact.
+#[test]
+fn contact_advance_is_the_pressed_points_speed_into_its_contact() {
+    let mut c = controller("planar7");
+    let config = c.config().clone();
+    let (model, layout, skin) = (&config.model, &config.layout, &config.skin);
+    let q = config.setup.posture.clone();
+    let mut data = crate::model::ModelData::new(model);
+    crate::model::update_kinematics(model, &mut data, &q, &vec![0.0; model.nv()]).unwrap();
+    let cell = &layout.cells()[3];
+    let outward = data.frame_pose(cell.frame).rotation * cell.normal_link;
+    let mut row = vec![0.0; model.nv()];
+    crate::model::point_jacobian_along(model, &data, cell.frame, &cell.position_link, &outward, &mut row).unwrap();
+    let norm2: f64 = row.iter().map(|r| r * r).sum();
+    let mut readings = vec![CellReading::default(); layout.num_cells()];
+    readings[3] = CellReading::uniform(skin.force.signal(2.0), 1.0);
+    let quiet = vec![CellReading::default(); layout.num_cells()];
+    for (k, speed) in [0.02, -0.01].into_iter().enumerate() {
+        let qd: Vec<f64> = row.iter().map(|r| r * speed / norm2).collect();
+        let input = ControllerInput { t_s: k as f64 * 0.008, dt_s: 0.008, q: &q, qd: &qd, cells: &readings, scan: &[] };
+        let advance = c.update(&input).signals.contact_advance_mps;
+        assert!((advance - speed).abs() < 1e-9, "{advance} m/s, the cell closes at {speed}");
+    }
+    let input = ControllerInput { t_s: 0.016, dt_s: 0.008, q: &q, qd: &row, cells: &quiet, scan: &[] };
+    assert!(c.update(&input).signals.contact_advance_mps.is_nan(), "no contact");
+}

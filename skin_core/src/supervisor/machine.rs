@@ -101,6 +101,11 @@ pub struct Supervisor {
     was_over: bool,
     /// When `‖F_c‖` last rose to ε_c in this (a) or (b) (NaN: not yet).
     last_strike_s: f64,
+    /// When `‖F_c‖` was last at or over ε_c (NaN: not yet).
+    last_over_s: f64,
+    /// The speed at which the link pressed hardest advanced into its contact, averaged over the
+    /// cycles in contact since the last switch (time constant `dwell.give_way_s`) \[m/s\].
+    advance_mps: f64,
     released: Dwell,
     stuck: Dwell,
     goal_reached: Dwell,
@@ -158,6 +163,8 @@ impl Supervisor {
             over_limit: Dwell::IDLE,
             was_over: false,
             last_strike_s: f64::NAN,
+            last_over_s: f64::NAN,
+            advance_mps: 0.0,
             released: Dwell::IDLE,
             stuck: Dwell::IDLE,
             goal_reached: Dwell::IDLE,
@@ -192,7 +199,7 @@ impl Supervisor {
             }
         } else {
             match self.policy {
-                Policy::IntentionalContact => self.step_table_i(t, input),
+                Policy::IntentionalContact => self.step_table_i(t, dt, input),
                 Policy::Phases => self.step_phases(t),
             }
             self.ramp_range(dt);
@@ -314,7 +321,7 @@ impl Supervisor {
     }
 
     /// Intentional-contact paper Table I with dwell times and hysteresis (rules in `docs/supervisor.md`).
-    fn step_table_i(&mut self, t: f64, u: &SupervisorInput) {
+    fn step_table_i(&mut self, t: f64, dt: f64, u: &SupervisorInput) {
         let th = self.thresholds;
         let dw = self.dwell;
         let fc = u.contact_force_n;
@@ -322,18 +329,31 @@ impl Supervisor {
         let impact = fc.is_nan() || fc >= th.impact_force_n;
         let strike = over && !self.was_over;
         self.was_over = over;
-        let struck_again = strike && t - self.last_strike_s <= dw.hard_contact_repeat_s; // NaN: false
+        // A dip under ε_c shorter than the gap is no release: a force that alternates over and
+        // under ε_c from one skin sample to the next is over it (the contact's own peaks are).
+        let held = over || t - self.last_over_s <= dw.hard_contact_gap_s; // NaN: false
+        if over {
+            self.last_over_s = t;
+        }
+        if u.contact_advance_mps.is_finite() && dt > 0.0 {
+            let a = 1.0 - (-dt / dw.give_way_s).exp();
+            self.advance_mps += (u.contact_advance_mps - self.advance_mps) * a;
+        }
+        // In a push (b), strikes of a contact that gives way are the peaks of an obstacle that
+        // slides, not a contact that keeps striking ε_c where it stands.
+        let mode = self.arrangement.mode;
+        let gave_way = mode == Mode::IntentionalContact && self.advance_mps >= th.give_way_speed_mps;
+        let struck_again = strike && t - self.last_strike_s <= dw.hard_contact_repeat_s && !gave_way; // NaN: false
         if strike {
             self.last_strike_s = t;
         }
         let below = fc < th.contact_force_n - th.contact_band_n; // NaN is never below
         let (v, fd, ge) = (u.ee_speed_mps, u.avoidance_force_n, u.goal_error_m);
         let invalid = v.is_nan() || fd.is_nan() || ge.is_nan();
-        let mode = self.arrangement.mode;
         match mode {
             Mode::Avoidance | Mode::IntentionalContact => {
                 // A hard contact can happen in (a) or (b): checked first, it has priority.
-                if self.over_limit.step(t, over, over, dw.hard_contact_s) || impact || struck_again {
+                if self.over_limit.step(t, over, held, dw.hard_contact_s) || impact || struck_again {
                     self.resume = mode;
                     if mode == Mode::IntentionalContact {
                         // Another try only if this push got the goal nearer (the obstacle gave
@@ -507,6 +527,7 @@ impl Supervisor {
         }
         self.progress = Progress::IDLE;
         self.last_strike_s = f64::NAN;
+        self.advance_mps = 0.0;
         self.peak_n = 0.0;
         let tr = Transition { t_s: t, from, to, cause };
         self.last_transition = Some(tr);

@@ -19,7 +19,7 @@
 //! let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../config/supervisor.yaml")).unwrap();
 //! let params = SupervisorParams::from_yaml_str(&text, "supervisor.yaml").unwrap();
 //! let mut sup = Supervisor::new(&params, 0.0).unwrap();
-//! let stuck = SupervisorInput { ee_speed_mps: 0.0, avoidance_force_n: 3.0, contact_force_n: 0.0, goal_error_m: 0.2 };
+//! let stuck = SupervisorInput { ee_speed_mps: 0.0, avoidance_force_n: 3.0, contact_force_n: 0.0, goal_error_m: 0.2, contact_advance_mps: f64::NAN };
 //! let mut t = 0.0;
 //! while sup.mode() == Mode::Avoidance { t += 0.01; sup.update(t, &stuck); }
 //! assert_eq!(sup.mode(), Mode::IntentionalContact);

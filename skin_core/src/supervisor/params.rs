@@ -95,6 +95,10 @@ declare_params! {
         /// Least fall of the goal error that counts as progress of a push (its retry) or of a
         /// blocked hold (its end).
         pub progress_min_m: f64 => { unit: "m", range: Range::closed(0.0, 1.0), live: false },
+        /// A contact gives way when the link pressed hardest advances into it at least this fast
+        /// on average (over `dwell.give_way_s`): a rise of `‖F_c‖` to ε_c is then no strike
+        /// again, but the peak of a push that slides.
+        pub give_way_speed_mps: f64 => { unit: "m/s", range: Range::closed(0.0, 1.0), live: false },
     }
 }
 
@@ -111,6 +115,12 @@ declare_params! {
         /// (a)/(b) → (c) at once: `‖F_c‖` rose to ε_c again within this long of its last rise
         /// (a contact that keeps striking ε_c is hard, however short each strike; 0: off).
         pub hard_contact_repeat_s: f64 => { unit: "s", range: DWELL_S, live: false },
+        /// The `hard_contact_s` dwell survives dips of `‖F_c‖` under ε_c this short: a contact
+        /// whose force alternates over and under ε_c from one skin sample to the next is over it.
+        pub hard_contact_gap_s: f64 => { unit: "s", range: DWELL_S, live: false },
+        /// Time constant of the average of the pressed link's advance that tells a contact that
+        /// gives way (`thresholds.give_way_speed_mps`); it starts from 0 at every switch.
+        pub give_way_s: f64 => { unit: "s", range: Range::positive(100.0), live: false },
         /// (c) → previous: contact force below ε_c − band.
         pub contact_release_s: f64 => { unit: "s", range: DWELL_S, live: false },
         /// (b) → (a): goal reached.

@@ -33,7 +33,18 @@ impl Rng {
 }
 
 fn input(v: f64, fd: f64, fc: f64, ge: f64) -> SupervisorInput {
-    SupervisorInput { ee_speed_mps: v, avoidance_force_n: fd, contact_force_n: fc, goal_error_m: ge }
+    SupervisorInput {
+        ee_speed_mps: v,
+        avoidance_force_n: fd,
+        contact_force_n: fc,
+        goal_error_m: ge,
+        contact_advance_mps: f64::NAN,
+    }
+}
+
+/// `u` with the pressed link advancing into its contact at `mps`.
+fn advancing(u: SupervisorInput, mps: f64) -> SupervisorInput {
+    SupervisorInput { contact_advance_mps: mps, ..u }
 }
 
 /// Runs `steps` cycles of `u` from `*t`; returns the transitions seen.
@@ -178,9 +189,10 @@ fn a_push_that_made_progress_is_retried_once_per_interval() {
     assert_eq!(tr.last().map(|tr| tr.cause), Some(Cause::PushBlocked));
 }
 
-/// `‖F_c‖ ≥ ε_c` is a hard contact when it lasts `hard_contact_s`, when it strikes ε_c again
-/// within `hard_contact_repeat_s` of its last strike, or at once from `impact_force_n`; one
-/// strike shorter than the dwell (a rigid touch's peak) is none.
+/// `‖F_c‖ ≥ ε_c` is a hard contact when it lasts `hard_contact_s` (dips shorter than
+/// `hard_contact_gap_s` included), when it strikes ε_c again within `hard_contact_repeat_s` of
+/// its last strike, or at once from `impact_force_n`; one strike shorter than the dwell (a rigid
+/// touch's peak) is none.
 #[test]
 fn a_hard_contact_lasts_strikes_again_or_is_an_impact() {
     let p = params();
@@ -188,7 +200,9 @@ fn a_hard_contact_lasts_strikes_again_or_is_an_impact() {
     let strike = input(0.02, 3.0, th.contact_force_n + 0.5, 0.2);
     let light = input(0.02, 3.0, 2.0, 0.2);
     let (mut sup, mut t) = in_b(&p);
-    assert!(run(&mut sup, &mut t, held(&p) - 4, strike).is_empty(), "shorter than the dwell");
+    // the dwell goes on through a dip shorter than the gap: the strike and the gap within it
+    let short = ((dw.hard_contact_s - dw.hard_contact_gap_s) / DT) as usize - 2;
+    assert!(run(&mut sup, &mut t, short, strike).is_empty(), "shorter than the dwell");
     let apart = (dw.hard_contact_repeat_s / DT) as usize + 2;
     assert!(run(&mut sup, &mut t, apart, light).is_empty());
     assert!(run(&mut sup, &mut t, 1, strike).is_empty(), "a strike more than repeat_s after the last");
@@ -200,6 +214,53 @@ fn a_hard_contact_lasts_strikes_again_or_is_an_impact() {
     let (mut sup, mut t) = in_b(&p);
     assert_eq!(run(&mut sup, &mut t, 1, input(0.02, 0.0, th.impact_force_n, 0.2)).len(), 1);
     assert_eq!(sup.mode(), Mode::HardContact, "an impact, at once");
+}
+
+/// In a push (b), a link that advances into its contact (the obstacle slides) may strike ε_c
+/// again and again, each strike shorter than the dwell: the peaks of a sliding push. The same
+/// strikes where the link stands are a hard contact, and so are strikes in (a).
+#[test]
+fn strikes_of_a_contact_that_gives_way_are_no_hard_contact() {
+    let p = params();
+    let (th, dw) = (p.thresholds, p.dwell);
+    let speed = 2.0 * th.give_way_speed_mps;
+    let strikes = |sup: &mut Supervisor, t: &mut f64, mps: f64| {
+        let (peak, push) = (input(0.02, 3.0, th.contact_force_n + 0.5, 0.2), input(0.02, 3.0, 3.0, 0.2));
+        let mut tr = run(sup, t, (2.0 * dw.give_way_s / DT) as usize, advancing(push, mps));
+        for _ in 0..5 {
+            tr.extend(run(sup, t, 2, advancing(peak, mps)));
+            tr.extend(run(sup, t, (0.2 / DT) as usize, advancing(push, mps)));
+        }
+        tr
+    };
+    let (mut sup, mut t) = in_b(&p);
+    assert!(strikes(&mut sup, &mut t, speed).is_empty(), "the obstacle gives way: a push with peaks");
+    let (mut sup, mut t) = in_b(&p);
+    let tr = strikes(&mut sup, &mut t, 0.0);
+    assert_eq!(tr.first().map(|tr| tr.to), Some(Mode::HardContact), "where the link stands: struck again");
+    let mut sup = Supervisor::new(&p, 0.0).unwrap();
+    let tr = strikes(&mut sup, &mut 0.0, speed);
+    assert_eq!(tr.first().map(|tr| tr.to), Some(Mode::HardContact), "in (a) nothing is pushed");
+}
+
+/// A force that alternates over and under ε_c from one skin sample to the next (the contact's
+/// peaks fall between the samples) is over ε_c for the dwell, however fast the link advances.
+#[test]
+fn a_force_flickering_over_eps_c_sample_by_sample_lasts() {
+    let p = params();
+    let (th, dw) = (p.thresholds, p.dwell);
+    assert!(2.0 * DT <= dw.hard_contact_gap_s, "a dip of one sample is within the gap");
+    let (mut sup, mut t) = in_b(&p);
+    let (over, under) = (input(0.02, 3.0, th.contact_force_n + 3.0, 0.2), input(0.02, 3.0, 2.0, 0.2));
+    assert!(run(&mut sup, &mut t, (2.0 * dw.give_way_s / DT) as usize, advancing(under, 0.05)).is_empty());
+    let t0 = t;
+    let mut tr = Vec::new();
+    while tr.is_empty() && t - t0 < 1.0 {
+        tr.extend(run(&mut sup, &mut t, 1, advancing(over, 0.05)));
+        tr.extend(run(&mut sup, &mut t, 1, advancing(under, 0.05)));
+    }
+    assert_eq!(tr.first().map(|tr| tr.to), Some(Mode::HardContact));
+    assert!(t - t0 >= dw.hard_contact_s && t - t0 <= dw.hard_contact_s + 3.0 * DT, "after the dwell: {}", t - t0);
 }
 
 /// A push in (b) that gets the goal less than `progress_min_m` nearer in `push_stall_s` (it

@@ -89,6 +89,10 @@ pub struct SupervisorInput {
     pub contact_force_n: f64,
     /// Distance of the end effector to its goal \[m\].
     pub goal_error_m: f64,
+    /// The speed at which the link pressed hardest moves into what it touches: its pressed
+    /// point's velocity along its force \[m/s\] (NaN: no contact). A contact that gives way
+    /// lets it advance; a rigid one holds it at 0.
+    pub contact_advance_mps: f64,
 }
 
 /// Why a transition happened.

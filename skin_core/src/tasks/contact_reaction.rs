@@ -32,8 +32,32 @@ pub struct ContactReaction {
     force: PreparedForce,
     /// Scratch: one cell's Jacobian row.
     row: Vec<f64>,
-    /// Scratch per model frame: the sum of its cells' measured forces along their normals.
-    link_force: Vec<Vector3<f64>>,
+    /// Scratch per model frame: its cells' measured forces, summed.
+    link_press: Vec<LinkPress>,
+}
+
+/// One link's contact this cycle (link frame): its cells' measured forces `F_i` along their
+/// outward normals `n_i`, summed, and the point where they press.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LinkContact {
+    /// The link's model frame.
+    pub frame: usize,
+    /// `Σ F_i n_i` \[N\]: its norm is the link's contact force, its direction the way the link
+    /// presses into what it touches.
+    pub force: Vector3<f64>,
+    /// `Σ F_i p_i / Σ F_i`, the force-weighted mean of the pressed cells' positions \[m\].
+    pub point: Vector3<f64>,
+}
+
+/// Sums of one link's pressed cells.
+#[derive(Debug, Clone, Copy, Default)]
+struct LinkPress {
+    /// `Σ F_i n_i`.
+    force: Vector3<f64>,
+    /// `Σ F_i p_i`.
+    weighted_points: Vector3<f64>,
+    /// `Σ F_i`.
+    total_n: f64,
 }
 
 /// Summary of one contact-reaction update, for the supervisor.
@@ -48,13 +72,15 @@ pub struct ContactSummary {
     /// presses its link with their sum; the largest single cell read 4.3 N where the link
     /// carried 6 N.
     pub max_link_n: f64,
+    /// The link pressed hardest (`‖F_c‖` is its force's norm), if any cell is in contact.
+    pub pressed: Option<LinkContact>,
 }
 
 impl ContactReaction {
     /// The task for a model with `nv` joints and `nframes` frames and cells with the force
     /// characteristic `force`; its level needs `layout.num_cells()` rows.
     pub fn new(nv: usize, nframes: usize, params: ContactReactionParams, force: &ForceCharacteristic) -> Self {
-        Self { params, force: force.prepared(), row: vec![0.0; nv], link_force: vec![Vector3::zeros(); nframes] }
+        Self { params, force: force.prepared(), row: vec![0.0; nv], link_press: vec![LinkPress::default(); nframes] }
     }
 
     /// Fills `level` (force rows) from the non-silent cells of this cycle's readings.
@@ -70,7 +96,7 @@ impl ContactReaction {
     ) -> Result<ContactSummary, TaskError> {
         level.clear();
         let row = &mut self.row;
-        self.params.contact_cells(layout, cells, &self.force, fusion, &mut self.link_force, |cell, fa| {
+        self.params.contact_cells(layout, cells, &self.force, fusion, &mut self.link_press, |cell, fa| {
             push_inward_cell_row(model, data, cell, fa, row, level)
         })
     }
@@ -82,27 +108,27 @@ impl ContactReaction {
         cells: &LiveCells,
         fusion: &FusionParams,
     ) -> Result<ContactSummary, TaskError> {
-        self.params.contact_cells(layout, cells, &self.force, fusion, &mut self.link_force, |_, _| Ok(()))
+        self.params.contact_cells(layout, cells, &self.force, fusion, &mut self.link_press, |_, _| Ok(()))
     }
 }
 
 impl ContactReactionParams {
     /// Calls `row(cell, (F_ci, a_i))` for every cell in contact (eq. 6) and sums them up; `a_i`
     /// rises with the measured force up to `activation_force_n`. Only the non-silent cells can
-    /// be in contact (a silent cell's force signal is 0). `link_force` (one per model frame) is
-    /// scratch for the links' summed forces, in the same pass.
+    /// be in contact (a silent cell's force signal is 0). `links` (one per model frame) is
+    /// scratch for the links' sums, in the same pass.
     fn contact_cells(
         &self,
         layout: &ResolvedLayout,
         cells: &LiveCells,
         force: &PreparedForce,
         fusion: &FusionParams,
-        link_force: &mut [Vector3<f64>],
+        links: &mut [LinkPress],
         mut row: impl FnMut(&ResolvedCell, (f64, f64)) -> Result<(), TaskError>,
     ) -> Result<ContactSummary, TaskError> {
         LengthMismatch::check_count(layout, cells.num_cells())?;
         let mut s = ContactSummary::default();
-        link_force.fill(Vector3::zeros());
+        links.fill(LinkPress::default());
         for (i, reading) in cells.cells() {
             let Some(measured) = fusion.cell_force_n(reading, force) else {
                 continue;
@@ -112,9 +138,18 @@ impl ContactReactionParams {
             row(cell, (f, row_activation(measured, self.activation_force_n)))?;
             s.rows += 1;
             s.max_force_n = s.max_force_n.max(f);
-            link_force[cell.frame] += cell.normal_link * measured; // link frame: the sign does not change the norm
+            let link = &mut links[cell.frame];
+            link.force += cell.normal_link * measured;
+            link.weighted_points += cell.position_link * measured;
+            link.total_n += measured;
         }
-        s.max_link_n = link_force.iter().map(|f| f.norm()).fold(0.0, f64::max);
+        for (frame, link) in links.iter().enumerate().filter(|(_, l)| l.total_n > 0.0) {
+            let n = link.force.norm();
+            if n > s.max_link_n {
+                s.max_link_n = n;
+                s.pressed = Some(LinkContact { frame, force: link.force, point: link.weighted_points / link.total_n });
+            }
+        }
         Ok(s)
     }
 }

@@ -252,6 +252,13 @@ fn contact_force_is_the_largest_link_force_summed_over_its_cells() {
     let forearm_n = (cells[a].normal_link + cells[b].normal_link).norm() * f;
     assert!(forearm_n > 1.5 * f, "neighbouring cells face nearly the same way");
     assert_relative_eq!(sum.max_link_n, forearm_n, epsilon = 1e-9);
+    // the link pressed hardest: its frame, its force and the point between its two cells
+    let pressed = sum.pressed.expect("cells in contact");
+    assert_eq!(pressed.frame, cells[a].frame);
+    assert_relative_eq!(pressed.force, (cells[a].normal_link + cells[b].normal_link) * f, epsilon = 1e-9);
+    assert_relative_eq!(pressed.point, (cells[a].position_link + cells[b].position_link) / 2.0, epsilon = 1e-9);
+    let none = LiveCells::from_readings(&vec![CellReading::uniform(0.0, 0.0); n], &s.skin.proximity);
+    assert_eq!(task.summarize(&s.layout, &none, &s.skin.fusion).unwrap().pressed, None);
 }
 
 /// The closing speed bound of the hand task: a hand moving into a surface faster than

@@ -339,6 +339,7 @@ impl RunOutput for RunBag {
                 ee_speed: s.ee_speed_mps,
                 avoidance_force: s.avoidance_force_n,
                 contact_force: s.contact_force_n,
+                contact_advance: s.contact_advance_mps,
                 torque_norm: c.torque_norm,
                 goal_error: if s.goal_error_m.is_nan() { -1.0 } else { s.goal_error_m },
                 releasing: c.releasing,

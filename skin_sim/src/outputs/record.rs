@@ -89,6 +89,7 @@ impl CycleRecord {
                 avoidance_force_n: 0.0,
                 contact_force_n: 0.0,
                 goal_error_m: 0.0,
+                contact_advance_mps: f64::NAN,
             },
             torque_norm: 0.0,
             hand_force_n: force_n,

@@ -74,9 +74,12 @@ def test_lockstep_processes_reproduce_the_in_process_loop(spawn, tmp_path, refer
     print(f"lockstep real-time factor (3 processes): {rec['realtime_factor']:.2f}")
     import signal
 
-    for p in (tc, sup):
-        p.send_signal(signal.SIGINT)
-    tc_out, sup_out = wait_ok(tc, 10), wait_ok(sup, 10)
+    # The supervisor first: it drains the states still on their way while the controller's
+    # writer lives (a writer that is gone takes its unacknowledged samples with it).
+    sup.send_signal(signal.SIGINT)
+    sup_out = wait_ok(sup, 10)
+    tc.send_signal(signal.SIGINT)
+    tc_out = wait_ok(tc, 10)
     assert "stopping after 2000 cycles (0 safe-stop steps" in tc_out, tc_out
     assert "stopping after 2000 controller states" in sup_out, sup_out
 

@@ -9,11 +9,14 @@ pub fn stream() -> QosProfile {
     QosProfile::default().reliable().keep_last(10)
 }
 
-/// Inputs whose every sample matters (the supervisor's dwell timers count controller states;
+/// Streams whose every sample matters (the supervisor's dwell timers count controller states;
 /// `/skin/cells` is event driven, a lost message would lose its cells' changes): a
 /// deep reader history, so a node that is descheduled for a while (lockstep simulation runs the
 /// graph several times faster than real time) catches up instead of losing samples; r2r takes
-/// one sample per spin, so the reader history is the only buffer.
+/// one sample per spin, so the reader history is the only buffer. A publisher of such a stream
+/// keeps as deep a history: a reliable writer drops the samples a slow reader has not
+/// acknowledged once they leave its history (the supervisor got 1887 of 2000 controller states
+/// under load with a writer history of 10).
 pub fn every_sample() -> QosProfile {
     QosProfile::default().reliable().keep_last(1000)
 }

@@ -670,7 +670,7 @@ pub fn start(node: &mut r2r::Node, spawner: &LocalSpawner, options: Options) -> 
             (true, false) => Some(BasePublisher::Twist(node.create_publisher(local(CMD_VEL), qos::stream())?)),
             (true, true) => Some(BasePublisher::Stamped(node.create_publisher(local(CMD_VEL), qos::stream())?)),
         },
-        state: node.create_publisher::<ControllerState>(local(CONTROLLER_STATE), qos::stream())?,
+        state: node.create_publisher::<ControllerState>(local(CONTROLLER_STATE), qos::every_sample())?,
     };
     // The command topics as resolved in the node's namespace, for the log and subscriber counts.
     let mut all_topics: Vec<String> = topics.iter().map(|t| resolved(node, t)).collect();

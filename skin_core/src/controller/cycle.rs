@@ -546,7 +546,7 @@ impl Controller {
         Ok(SupervisorInput {
             ee_speed_mps: speed,
             avoidance_force_n: avoid.force_norm_n,
-            contact_force_n: contact.max_link_n,
+            contact_force_n: contact.max_link_n(),
             goal_error_m: goal_error,
             contact_advance_mps: advance,
         })

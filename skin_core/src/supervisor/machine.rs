@@ -104,7 +104,7 @@ pub struct Supervisor {
     /// When `‖F_c‖` was last at or over ε_c (NaN: not yet).
     last_over_s: f64,
     /// The speed at which the link pressed hardest advanced into its contact, averaged over the
-    /// cycles in contact since the last switch (time constant `dwell.give_way_s`) \[m/s\].
+    /// cycles in contact of this push (b) (time constant `dwell.give_way_s`) \[m/s\].
     advance_mps: f64,
     released: Dwell,
     stuck: Dwell,
@@ -335,14 +335,15 @@ impl Supervisor {
         if over {
             self.last_over_s = t;
         }
-        if u.contact_advance_mps.is_finite() && dt > 0.0 {
-            let a = 1.0 - (-dt / dw.give_way_s).exp();
-            self.advance_mps += (u.contact_advance_mps - self.advance_mps) * a;
-        }
         // In a push (b), strikes of a contact that gives way are the peaks of an obstacle that
         // slides, not a contact that keeps striking ε_c where it stands.
         let mode = self.arrangement.mode;
-        let gave_way = mode == Mode::IntentionalContact && self.advance_mps >= th.give_way_speed_mps;
+        let pushing = mode == Mode::IntentionalContact;
+        if pushing && u.contact_advance_mps.is_finite() && dt > 0.0 {
+            let a = 1.0 - (-dt / dw.give_way_s).exp();
+            self.advance_mps += (u.contact_advance_mps - self.advance_mps) * a;
+        }
+        let gave_way = pushing && self.advance_mps >= th.give_way_speed_mps;
         let struck_again = strike && t - self.last_strike_s <= dw.hard_contact_repeat_s && !gave_way; // NaN: false
         if strike {
             self.last_strike_s = t;

@@ -1,12 +1,13 @@
 //! The skin's approach bound (`docs/resolver.md`): for every cell that senses a surface, the
 //! speed at which its point closes on it, `nᵀ J_v(p) q̇`, limited to the bound at the sensed
 //! distance and force, as a limit the resolver meets. A link that pushes something that gives
-//! way pushes faster than it touches.
+//! way pushes faster than it touches, and holds its force under `ε_c`.
 
 use crate::model::{point_jacobian_along, ModelData, ModelError, RobotModel};
 use crate::resolver::{ApproachParams, ClosingBounds};
 use crate::skin::aggregate::FusionParams;
 use crate::skin::characteristic::PreparedForce;
+use crate::skin::contacts::LinkContacts;
 use crate::skin::layout::ResolvedLayout;
 use crate::skin::live::LiveCells;
 use crate::supervisor::Thresholds;
@@ -28,8 +29,8 @@ pub(crate) enum ContactIntent {
 pub(crate) struct ContactLevels {
     /// No contact at or below this (Table I (a): `‖F_c‖ = 0`).
     pub(crate) zero_n: f64,
-    /// A hard contact is released below this (`ε_c` − band): a push under it gives way.
-    pub(crate) release_n: f64,
+    /// A push holds its link's force at this (`ε_c` − `push_margin_n`).
+    pub(crate) push_n: f64,
     /// `ε_c`: no cell is pushed into it.
     pub(crate) limit_n: f64,
 }
@@ -37,11 +38,7 @@ pub(crate) struct ContactLevels {
 impl ContactLevels {
     /// The levels of the supervisor's thresholds.
     pub(crate) fn of(th: &Thresholds) -> Self {
-        Self {
-            zero_n: th.contact_zero_n,
-            release_n: th.contact_force_n - th.contact_band_n,
-            limit_n: th.contact_force_n,
-        }
+        Self { zero_n: th.contact_zero_n, push_n: th.contact_force_n - th.push_margin_n, limit_n: th.contact_force_n }
     }
 }
 
@@ -51,13 +48,13 @@ pub(crate) struct ApproachBound {
     params: ApproachParams,
     levels: ContactLevels,
     force: PreparedForce,
-    /// Per model frame: the speed at contact of the link's cells \[m/s\] (`speed_min_mps` up to
-    /// `push_speed_max_mps` while the link pushes something that gives way).
+    /// Per model frame: the speed at contact of the link's cells \[m/s\] (0 up to
+    /// `push_speed_max_mps` in a push, regulated by the link's force).
     push_mps: Vec<f64>,
-    /// Scratch per model frame: the force on the link's cells this cycle \[N\].
+    /// Scratch per model frame: the force on the link's cells this cycle, summed \[N\].
     pressed_n: Vec<f64>,
-    /// Scratch per model frame: the largest force on one of the link's cells this cycle \[N\].
-    hardest_n: Vec<f64>,
+    /// The links' contacts: their forces this cycle.
+    contacts: LinkContacts,
     /// Scratch per live cell: its measured force this cycle \[N\] (0 below the threshold).
     forces_n: Vec<f64>,
     /// Scratch: one cell's row.
@@ -65,23 +62,24 @@ pub(crate) struct ApproachBound {
 }
 
 impl ApproachBound {
-    /// The bound on a model with `nv` joints and `nframes` frames and a layout of `cells` cells;
-    /// the contact `levels` are read through `force`.
+    /// The bound on a model with `nv` joints and `nframes` frames and the skin `layout`; the
+    /// contact `levels` are read through `force`.
     pub(crate) fn new(
         params: ApproachParams,
         levels: ContactLevels,
         force: PreparedForce,
         nv: usize,
         nframes: usize,
-        cells: usize,
+        layout: &ResolvedLayout,
     ) -> Self {
+        let cells = layout.num_cells();
         Self {
             params,
             levels,
             force,
             push_mps: vec![params.speed_min_mps; nframes],
             pressed_n: vec![0.0; nframes],
-            hardest_n: vec![0.0; nframes],
+            contacts: LinkContacts::new(layout, nframes),
             forces_n: Vec::with_capacity(cells),
             row: vec![0.0; nv],
         }
@@ -100,14 +98,16 @@ impl ApproachBound {
     ///   given up ([`ContactIntent::Release`]): nothing drives the body back into a contact the
     ///   reaction relieves (the goal below the reaction did, a limit cycle of touches for the rest
     ///   of the run);
-    /// - in a push ([`ContactIntent::Push`]), growing by `push_accel_mps2` up to
-    ///   `push_speed_max_mps` while the link is in contact (its cells' forces sum above no
-    ///   contact) and none of its cells is pressed at the release level of a hard contact (a
-    ///   level of the supervisor's; compared per cell, not with the link's force `‖F_c‖`, which
-    ///   sums a spread contact past it and stopped pushes, `docs/resolver.md`): it pushes something that
-    ///   slides (a push at the touch speed would take 10 s for 20 cm); falling back as fast when
-    ///   the pushed thing slid ahead out of contact, and at once to the touch speed when a cell
-    ///   is pressed at that level;
+    /// - in a push ([`ContactIntent::Push`]), regulated by the link's force `F`, the sum over its
+    ///   contacts of their `‖Σ F_i n_i‖` ([`LinkContacts`]; the supervisor's `‖F_c‖` of the link
+    ///   when one thing presses it), about its push force `F_p = ε_c − push_margin_n`:
+    ///   under it, growing by `push_force_gain_mps2_per_n · (F_p − F)` per second, at most
+    ///   `push_accel_mps2`, up to `push_speed_max_mps`: it pushes something that slides (a push
+    ///   at the touch speed would take 10 s for 20 cm); over it, at once at most the touch speed
+    ///   and falling by the gain times the excess, down to 0: a link that pushes what does not
+    ///   give way holds `F_p`, under `ε_c` by the margin a skin that reads low needs
+    ///   (`docs/resolver.md`). Falling back to the touch speed when the pushed thing slid ahead
+    ///   out of contact (its cells' forces sum to no contact);
     /// - otherwise the touch speed `speed_min_mps`.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn update(
@@ -127,27 +127,31 @@ impl ApproachBound {
         }
         let (p, levels) = (&self.params, self.levels);
         self.pressed_n.fill(0.0);
-        self.hardest_n.fill(0.0);
         self.forces_n.clear(); // within capacity: one per layout cell at most
         for (i, reading) in cells.cells() {
             let f = fusion.cell_force_n(reading, &self.force).unwrap_or(0.0);
-            let frame = layout.cells()[*i].frame;
-            self.pressed_n[frame] += f;
-            self.hardest_n[frame] = self.hardest_n[frame].max(f);
+            self.pressed_n[layout.cells()[*i].frame] += f;
             self.forces_n.push(f);
         }
         let dt = if dt_s.is_finite() { dt_s.max(0.0) } else { 0.0 };
-        let (touch, fastest, dv) = (p.speed_min_mps, p.push_speed_max_mps, p.push_accel_mps2 * dt);
-        for ((v, &f), &hardest) in self.push_mps.iter_mut().zip(&self.pressed_n).zip(&self.hardest_n) {
-            *v = if intent != ContactIntent::Push {
-                touch
-            } else if f > levels.zero_n && hardest < levels.release_n {
-                (*v + dv).min(fastest)
-            } else if f <= levels.zero_n {
-                (*v - dv).max(touch) // a pushed object that slid ahead: the push goes on
-            } else {
-                touch // NaN too
-            };
+        let (touch, fastest, accel, gain) =
+            (p.speed_min_mps, p.push_speed_max_mps, p.push_accel_mps2, p.push_force_gain_mps2_per_n);
+        if intent == ContactIntent::Push {
+            let ids = cells.cells().iter().map(|(i, _)| *i);
+            let link_n = self.contacts.update(layout, ids.zip(self.forces_n.iter().copied()));
+            for ((v, &total), &f) in self.push_mps.iter_mut().zip(&self.pressed_n).zip(link_n) {
+                *v = if total.is_nan() {
+                    0.0
+                } else if total <= levels.zero_n {
+                    (*v - accel * dt).max(touch) // a pushed object that slid ahead: the push goes on
+                } else if f <= levels.push_n {
+                    (*v + dt * accel.min(gain * (levels.push_n - f))).min(fastest)
+                } else {
+                    (v.min(touch) - dt * gain * (f - levels.push_n)).max(0.0)
+                };
+            }
+        } else {
+            self.push_mps.fill(touch);
         }
         let range = cells.proximity_range_m();
         // a cell without proximity signal is at the range: it senses nothing

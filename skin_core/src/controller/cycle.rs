@@ -149,8 +149,7 @@ impl Controller {
             .map_err(|error| SetupError::Resolver { file: config.setup.resolver.display().to_string(), error })?;
         let levels = ContactLevels::of(&config.supervisor.thresholds);
         let force = config.skin.force.prepared();
-        let cells = config.layout.num_cells();
-        let approach = ApproachBound::new(config.resolver.approach, levels, force, nv, model.nframes(), cells);
+        let approach = ApproachBound::new(config.resolver.approach, levels, force, nv, model.nframes(), &config.layout);
         *resolver.closing_bounds_mut() = approach.limits();
         let supervisor = Supervisor::new(&config.supervisor, t0_s)?;
         let output = ControllerOutput {

@@ -402,43 +402,47 @@ fn no_skin_point_closes_on_a_sensed_surface_faster_than_the_approach_bound() {
     assert!(max(&runs[10..], |c| c.1) < 1e-3, "after the start: {} m/s over", max(&runs[10..], |c| c.1));
 }
 
-/// The speed at contact of a link's cells (the limit at `d = 0`): the touch speed, growing by
-/// the push acceleration up to the fastest push while the link is in contact (its cells' forces
-/// sum above no contact) and none of its cells is pressed at the release level of a hard contact
-/// (the supervisor's level, compared per cell) in a push (b); falling back as fast when
-/// the link is out of contact; back at the touch speed at once when a cell is pressed at that
-/// level and in any other arrangement; 0 for a cell at `ε_c` and when the contact is to be released.
+/// The speed at contact of a link's cells (the limit at `d = 0`) in a push (b), regulated by the
+/// link's force `F = ‖Σ F_i n_i‖` about its push force `F_p = ε_c − push_margin_n`: from the
+/// touch speed, growing by the push acceleration while `F` is far under `F_p` and by the gain
+/// times `F_p − F` near it, up to the fastest push; over `F_p` at once the touch speed, falling
+/// by the gain times the excess down to 0 (a push that does not give way holds `F_p`); the link's
+/// force, not its hardest cell; falling back by the acceleration out of contact; the touch speed
+/// in any other arrangement; 0 for a cell at `ε_c` and when the contact is to be released.
 #[test]
-fn a_link_pushing_what_gives_way_pushes_faster_than_it_touches() {
+fn a_push_regulates_its_links_force_under_eps_c() {
     use super::approach::{ApproachBound, ContactIntent, ContactLevels};
     use crate::skin::live::LiveCells;
     let config = ControllerConfig::load(&setup("planar7")).unwrap();
     let (model, layout, skin) = (&config.model, &config.layout, &config.skin);
     let (p, th) = (config.resolver.approach, config.supervisor.thresholds);
     let levels = ContactLevels::of(&th);
-    let release_n = levels.release_n;
+    let push_n = levels.push_n;
+    assert!(push_n < th.contact_force_n && push_n > th.contact_zero_n, "{push_n}");
     let cells = layout.num_cells();
-    let mut bound = ApproachBound::new(p, levels, skin.force.prepared(), model.nv(), model.nframes(), cells);
+    let mut bound = ApproachBound::new(p, levels, skin.force.prepared(), model.nv(), model.nframes(), layout);
     let mut limits = bound.limits();
     let mut data = crate::model::ModelData::new(model);
     crate::model::update_kinematics(model, &mut data, &config.setup.posture, &vec![0.0; model.nv()]).unwrap();
     let pressed = 0;
-    let frame = layout.cells()[pressed].frame;
-    let on_link = (1..cells).find(|&i| layout.cells()[i].frame == frame).unwrap();
-    let elsewhere = (0..cells).find(|&i| layout.cells()[i].frame != frame).unwrap();
+    let cell = |i: usize| &layout.cells()[i];
+    let frame = cell(pressed).frame;
+    // the cell of the same link facing most nearly the same way: two cells of one contact
+    let beside = (1..cells)
+        .filter(|&i| cell(i).frame == frame)
+        .max_by(|&i, &j| {
+            let d = |k: usize| cell(k).normal_link.dot(&cell(pressed).normal_link);
+            d(i).total_cmp(&d(j))
+        })
+        .unwrap();
+    let elsewhere = (0..cells).find(|&i| cell(i).frame != frame).unwrap();
     let dt = 0.01;
-    // every cell touches a surface (d = 0), the first one pressed with `force_n` and another of
-    // its link with `beside_n`: the speeds at contact of these two and of a cell of another link
+    // every cell touches a surface (d = 0), the first one pressed with `force_n` and the one
+    // beside it with `beside_n`: the speeds at contact of these two and of a cell of another link
     let mut step2 = |force_n: f64, beside_n: f64, intent: ContactIntent| {
         let readings: Vec<CellReading> = (0..cells)
             .map(|i| {
-                let f = if i == pressed {
-                    force_n
-                } else if i == on_link {
-                    beside_n
-                } else {
-                    0.0
-                };
+                let f = [(pressed, force_n), (beside, beside_n)].iter().find(|(c, _)| *c == i).map_or(0.0, |x| x.1);
                 CellReading::uniform(if f > 0.0 { skin.force.signal(f) } else { 0.0 }, 1.0)
             })
             .collect();
@@ -446,32 +450,83 @@ fn a_link_pushing_what_gives_way_pushes_faster_than_it_touches() {
         bound.update(model, &data, layout, &live, &skin.fusion, intent, dt, &mut limits).unwrap();
         let speeds: Vec<f64> = limits.iter().map(|(_, b)| b).collect();
         assert_eq!(speeds.len(), cells, "every touching cell has a limit");
-        (speeds[pressed], speeds[on_link], speeds[elsewhere])
+        (speeds[pressed], speeds[beside], speeds[elsewhere])
     };
-    let (touch, fastest, a) = (p.speed_min_mps, p.push_speed_max_mps, p.push_accel_mps2);
-    let push_n = 0.5 * (th.contact_zero_n + release_n);
-    assert!(touch + 10.0 * a * dt < fastest, "the ramp is seen before it saturates");
-    let mut last = (0.0, 0.0, 0.0);
-    for k in 1..=10 {
-        last = step2(push_n, 0.0, ContactIntent::Push);
-        let v = touch + k as f64 * a * dt;
-        assert!((last.0 - v).abs() < 1e-9 && (last.1 - v).abs() < 1e-9, "step {k}: {last:?}, expected {v}");
-        assert_eq!(last.2, touch, "another link touches");
+    let (touch, fastest, a, k) =
+        (p.speed_min_mps, p.push_speed_max_mps, p.push_accel_mps2, p.push_force_gain_mps2_per_n);
+    let far = push_n - 2.0 * a / k; // the rise is the acceleration's
+    assert!(far > th.contact_zero_n && touch + 10.0 * a * dt < fastest, "the ramp is seen before it saturates");
+    let close = |x: f64, y: f64| (x - y).abs() < 1e-9;
+    let mut v = touch;
+    for n in 1..=10 {
+        let got = step2(far, 0.0, ContactIntent::Push);
+        v += a * dt;
+        assert!(close(got.0, v) && close(got.1, v), "step {n}: {got:?}, expected {v}");
+        assert_eq!(got.2, touch, "another link touches");
     }
-    let spread = 0.9 * release_n;
-    let v = step2(spread, spread, ContactIntent::Push).0;
-    assert!(v > last.0, "two cells under the release level, their sum over it: still a push ({v})");
+    let near = push_n - 0.5 * a / k; // the rise is the gain's: half the acceleration
+    v += 0.5 * a * dt;
+    assert!(close(step2(near, 0.0, ContactIntent::Push).0, v), "near the push force: slower");
     for _ in 0..((fastest / (a * dt)) as usize) {
-        last = step2(push_n, 0.0, ContactIntent::Push);
+        v = step2(far, 0.0, ContactIntent::Push).0;
     }
-    assert_eq!(last.0, fastest, "the fastest push");
-    let mut step = |force_n: f64, intent: ContactIntent| step2(force_n, 0.0, intent);
-    assert!((step(0.0, ContactIntent::Push).0 - (fastest - a * dt)).abs() < 1e-9, "out of contact: falls back");
-    assert_eq!(step(release_n + 0.1, ContactIntent::Push).0, touch, "at the release level: the touch");
-    step(push_n, ContactIntent::Push);
-    assert_eq!(step(push_n, ContactIntent::Touch).0, touch, "no push outside (b)");
-    assert_eq!(step(push_n, ContactIntent::Release), (0.0, 0.0, 0.0), "releasing: nothing closes");
-    assert_eq!(step(th.contact_force_n, ContactIntent::Push).0, 0.0, "no cell is pushed into eps_c");
+    assert_eq!(v, fastest, "the fastest push");
+    assert!(close(step2(0.0, 0.0, ContactIntent::Push).0, fastest - a * dt), "out of contact: falls back");
+    let over = 0.5 * (th.contact_force_n - push_n); // under eps_c: no cell at the limit
+    v = touch;
+    for n in 1..=3 {
+        v -= k * over * dt;
+        let got = step2(push_n + over, 0.0, ContactIntent::Push).0;
+        assert!(
+            close(got, v),
+            "over the push force, step {n}: {got}, expected {v} (the touch speed at once, then less)"
+        );
+    }
+    for _ in 0..((touch / (k * over * dt)) as usize + 2) {
+        v = step2(push_n + over, 0.0, ContactIntent::Push).0;
+    }
+    assert_eq!(v, 0.0, "a push that does not give way holds its force: nothing closes");
+    assert!(close(step2(far, 0.0, ContactIntent::Push).0, a * dt), "under the push force again: the push resumes");
+    // two cells of one contact, each under the push force: their link's force is over it
+    let f = 0.6 * push_n;
+    let link_n = (f * (cell(pressed).normal_link + cell(beside).normal_link)).norm();
+    assert!(link_n > push_n, "the two cells face the same way ({link_n} N)");
+    let got = step2(f, f, ContactIntent::Push).0;
+    assert!(got <= touch, "the link's force, not its hardest cell: {got}");
+    step2(far, 0.0, ContactIntent::Push);
+    assert_eq!(step2(far, 0.0, ContactIntent::Touch).0, touch, "no push outside (b)");
+    assert_eq!(step2(far, 0.0, ContactIntent::Release), (0.0, 0.0, 0.0), "releasing: nothing closes");
+    assert_eq!(step2(th.contact_force_n, 0.0, ContactIntent::Push).0, 0.0, "no cell is pushed into eps_c");
+}
+
+/// A link's contacts ([`crate::skin::contacts::LinkContacts`]): neighbouring pressed cells are
+/// one contact, the norm of their vector sum; cells on opposite sides of a link are two, the sum
+/// of their forces (a link squeezed between two obstacles, whose vector sum nearly cancels);
+/// cells of two links are apart, and unpressed cells are no contact.
+#[test]
+fn a_link_squeezed_from_two_sides_has_two_contacts() {
+    use crate::skin::contacts::LinkContacts;
+    use approx::assert_relative_eq;
+    let config = ControllerConfig::load(&setup("planar7")).unwrap();
+    let layout = &config.layout;
+    let mut contacts = LinkContacts::new(layout, config.model.nframes());
+    let cells = layout.cells();
+    let a = 0;
+    let frame = cells[a].frame;
+    let on_link = || (0..cells.len()).filter(move |&i| i != a && cells[i].frame == frame);
+    let by = |key: &dyn Fn(usize) -> f64| on_link().min_by(|&i, &j| key(i).total_cmp(&key(j))).unwrap();
+    let near = by(&|i| (cells[i].position_link - cells[a].position_link).norm());
+    let opposite = by(&|i| cells[i].normal_link.dot(&cells[a].normal_link));
+    let other = (0..cells.len()).find(|&i| cells[i].frame != frame).unwrap();
+    let (f, g) = (2.0, 3.0);
+    let one = (f * cells[a].normal_link + g * cells[near].normal_link).norm();
+    assert_relative_eq!(contacts.update(layout, [(a, f), (near, g)].into_iter())[frame], one, epsilon = 1e-12);
+    let squeezed = (f * cells[a].normal_link + g * cells[opposite].normal_link).norm();
+    assert!(squeezed < 0.5 * (f + g), "the two cells face apart: {squeezed}");
+    assert_relative_eq!(contacts.update(layout, [(a, f), (opposite, g)].into_iter())[frame], f + g, epsilon = 1e-12);
+    let apart = contacts.update(layout, [(a, f), (other, g), (near, 0.0)].into_iter()).to_vec();
+    assert_relative_eq!(apart[frame], f, epsilon = 1e-12);
+    assert_relative_eq!(apart[cells[other].frame], g, epsilon = 1e-12);
 }
 
 /// The supervisor's `contact_advance_mps`: the point where the link pressed hardest is pressed,

@@ -40,14 +40,18 @@ declare_params! {
         pub speed_min_mps: f64 => { unit: "m/s", range: Range::positive(10.0), live: false },
         /// Time in which the allowed closing speed would cover the sensed distance.
         pub time_s: f64 => { unit: "s", range: Range::positive(100.0), live: false },
-        /// A link in contact with none of its cells at the release level of a hard contact
-        /// pushes something that gives way: its speed at contact grows from `speed_min_mps` by
-        /// this much per second.
+        /// In a push, a link pressed under its push force (`ε_c −
+        /// thresholds.push_margin_n`) pushes something that gives way: its speed at contact
+        /// grows from `speed_min_mps` by at most this much per second.
         #[serde(default = "default_push_accel")]
         pub push_accel_mps2: f64 => { unit: "m/s²", range: Range::closed(0.0, 100.0), live: false },
         /// The fastest push into a surface that gives way.
         #[serde(default = "default_push_speed_max")]
         pub push_speed_max_mps: f64 => { unit: "m/s", range: Range::positive(10.0), live: false },
+        /// The push force's regulator: the speed at contact changes by this much per second per
+        /// newton of the link's force under (up to `push_accel_mps2`) or over its push force.
+        #[serde(default = "default_push_force_gain")]
+        pub push_force_gain_mps2_per_n: f64 => { unit: "m/s² per N", range: Range::closed(0.0, 100.0), live: false },
     }
 }
 
@@ -59,10 +63,21 @@ fn default_push_speed_max() -> f64 {
     ApproachParams::default().push_speed_max_mps
 }
 
+fn default_push_force_gain() -> f64 {
+    ApproachParams::default().push_force_gain_mps2_per_n
+}
+
 impl Default for ApproachParams {
     /// The shipped values (`config/resolver.yaml`).
     fn default() -> Self {
-        Self { enabled: true, speed_min_mps: 0.02, time_s: 0.5, push_accel_mps2: 0.1, push_speed_max_mps: 0.1 }
+        Self {
+            enabled: true,
+            speed_min_mps: 0.02,
+            time_s: 0.5,
+            push_accel_mps2: 0.1,
+            push_speed_max_mps: 0.1,
+            push_force_gain_mps2_per_n: 0.1,
+        }
     }
 }
 

@@ -18,6 +18,7 @@ pub mod aggregate;
 pub mod cell_forces;
 pub mod cell_input;
 pub mod characteristic;
+pub mod contacts;
 pub mod coverage;
 pub mod generate;
 pub mod layout;

@@ -99,6 +99,10 @@ declare_params! {
         /// on average (over `dwell.give_way_s`): a rise of `‖F_c‖` to ε_c is then no strike
         /// again, but the peak of a push that slides.
         pub give_way_speed_mps: f64 => { unit: "m/s", range: Range::closed(0.0, 1.0), live: false },
+        /// A push (b) holds its link's force at `ε_c −` this margin (the skin's approach bound,
+        /// `docs/resolver.md`): a skin that reads a contact this much low still presses under
+        /// ε_c. Below `contact_force_n`.
+        pub push_margin_n: f64 => { unit: "N", range: Range::closed(0.0, 1e3), live: false },
     }
 }
 
@@ -254,27 +258,22 @@ impl SupervisorParams {
         self.task_indices().map(|_| ())?;
         self.check("")?;
         let (t, r) = (&self.thresholds, &self.sensing_range);
-        if t.contact_band_n >= t.contact_force_n {
-            return Err(InvalidParam {
-                key: "thresholds.contact_band_n".into(),
-                value: t.contact_band_n,
-                reason: "must be < contact_force_n (else hard contact is never left)".into(),
+        // the levels under ε_c
+        for (key, value, why) in [
+            ("contact_band_n", t.contact_band_n, "else hard contact is never left"),
+            ("contact_zero_n", t.contact_zero_n, "no contact is below the hard-contact limit"),
+            ("push_margin_n", t.push_margin_n, "else a push presses nothing"),
+        ] {
+            if value >= t.contact_force_n {
+                let reason = format!("must be < contact_force_n ({why})");
+                return Err(InvalidParam { key: format!("thresholds.{key}"), value, reason: reason.into() }.into());
             }
-            .into());
         }
         if t.impact_force_n < t.contact_force_n {
             return Err(InvalidParam {
                 key: "thresholds.impact_force_n".into(),
                 value: t.impact_force_n,
                 reason: "must be >= contact_force_n (an impact is a hard contact)".into(),
-            }
-            .into());
-        }
-        if t.contact_zero_n >= t.contact_force_n {
-            return Err(InvalidParam {
-                key: "thresholds.contact_zero_n".into(),
-                value: t.contact_zero_n,
-                reason: "must be < contact_force_n (no contact is below the hard-contact limit)".into(),
             }
             .into());
         }

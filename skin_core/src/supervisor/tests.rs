@@ -798,6 +798,7 @@ fn other_invalid_values_are_rejected() {
         ("stuck_s: 0.5", "stuck_s: -0.5", "dwell.stuck_s"),
         ("log_capacity: 64", "log_capacity: 0", "log_capacity"),
         ("impact_force_n: 10.0", "impact_force_n: 4.0", "thresholds.impact_force_n"),
+        ("push_margin_n: 0.5", "push_margin_n: 5.0", "thresholds.push_margin_n"),
         ("push_stall_s: 3.0", "push_stall_s: 0.0", "dwell.push_stall_s"),
     ] {
         let e = load_err(old, new);

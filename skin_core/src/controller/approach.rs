@@ -51,8 +51,6 @@ pub(crate) struct ApproachBound {
     /// Per model frame: the speed at contact of the link's cells \[m/s\] (0 up to
     /// `push_speed_max_mps` in a push, regulated by the link's force).
     push_mps: Vec<f64>,
-    /// Scratch per model frame: the force on the link's cells this cycle, summed \[N\].
-    pressed_n: Vec<f64>,
     /// The links' contacts: their forces this cycle.
     contacts: LinkContacts,
     /// Scratch per live cell: its measured force this cycle \[N\] (0 below the threshold).
@@ -78,7 +76,6 @@ impl ApproachBound {
             levels,
             force,
             push_mps: vec![params.speed_min_mps; nframes],
-            pressed_n: vec![0.0; nframes],
             contacts: LinkContacts::new(layout, nframes),
             forces_n: Vec::with_capacity(cells),
             row: vec![0.0; nv],
@@ -126,23 +123,19 @@ impl ApproachBound {
             return Ok(());
         }
         let (p, levels) = (&self.params, self.levels);
-        self.pressed_n.fill(0.0);
         self.forces_n.clear(); // within capacity: one per layout cell at most
-        for (i, reading) in cells.cells() {
-            let f = fusion.cell_force_n(reading, &self.force).unwrap_or(0.0);
-            self.pressed_n[layout.cells()[*i].frame] += f;
-            self.forces_n.push(f);
+        for (_, reading) in cells.cells() {
+            self.forces_n.push(fusion.cell_force_n(reading, &self.force).unwrap_or(0.0));
         }
         let dt = if dt_s.is_finite() { dt_s.max(0.0) } else { 0.0 };
         let (touch, fastest, accel, gain) =
             (p.speed_min_mps, p.push_speed_max_mps, p.push_accel_mps2, p.push_force_gain_mps2_per_n);
         if intent == ContactIntent::Push {
             let ids = cells.cells().iter().map(|(i, _)| *i);
-            let link_n = self.contacts.update(layout, ids.zip(self.forces_n.iter().copied()));
-            for ((v, &total), &f) in self.push_mps.iter_mut().zip(&self.pressed_n).zip(link_n) {
-                *v = if total.is_nan() {
-                    0.0
-                } else if total <= levels.zero_n {
+            let links = self.contacts.update(layout, ids.zip(self.forces_n.iter().copied()));
+            for (v, link) in self.push_mps.iter_mut().zip(links) {
+                let f = link.contact_n;
+                *v = if link.pressed_n <= levels.zero_n {
                     (*v - accel * dt).max(touch) // a pushed object that slid ahead: the push goes on
                 } else if f <= levels.push_n {
                     (*v + dt * accel.min(gain * (levels.push_n - f))).min(fastest)

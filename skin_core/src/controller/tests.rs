@@ -520,13 +520,19 @@ fn a_link_squeezed_from_two_sides_has_two_contacts() {
     let other = (0..cells.len()).find(|&i| cells[i].frame != frame).unwrap();
     let (f, g) = (2.0, 3.0);
     let one = (f * cells[a].normal_link + g * cells[near].normal_link).norm();
-    assert_relative_eq!(contacts.update(layout, [(a, f), (near, g)].into_iter())[frame], one, epsilon = 1e-12);
+    assert_relative_eq!(
+        contacts.update(layout, [(a, f), (near, g)].into_iter())[frame].contact_n,
+        one,
+        epsilon = 1e-12
+    );
     let squeezed = (f * cells[a].normal_link + g * cells[opposite].normal_link).norm();
     assert!(squeezed < 0.5 * (f + g), "the two cells face apart: {squeezed}");
-    assert_relative_eq!(contacts.update(layout, [(a, f), (opposite, g)].into_iter())[frame], f + g, epsilon = 1e-12);
+    let squeeze = contacts.update(layout, [(a, f), (opposite, g)].into_iter())[frame];
+    assert_relative_eq!(squeeze.contact_n, f + g, epsilon = 1e-12);
+    assert_relative_eq!(squeeze.pressed_n, f + g, epsilon = 1e-12);
     let apart = contacts.update(layout, [(a, f), (other, g), (near, 0.0)].into_iter()).to_vec();
-    assert_relative_eq!(apart[frame], f, epsilon = 1e-12);
-    assert_relative_eq!(apart[cells[other].frame], g, epsilon = 1e-12);
+    assert_relative_eq!(apart[frame].contact_n, f, epsilon = 1e-12);
+    assert_relative_eq!(apart[cells[other].frame].contact_n, g, epsilon = 1e-12);
 }
 
 /// The supervisor's `contact_advance_mps`: the point where the link pressed hardest is pressed,

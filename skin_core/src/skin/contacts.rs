@@ -11,6 +11,15 @@ use super::resolved::ResolvedLayout;
 /// widest cell spacing apart (the largest distance from one of its cells to the nearest other).
 const NEIGHBOUR_SPACINGS: f64 = 1.5;
 
+/// One link's press this cycle \[N\].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LinkForce {
+    /// `Σ F_i` over its pressed cells: whether it is in contact at all.
+    pub pressed_n: f64,
+    /// The sum over its contacts of their `‖Σ F_i n_i‖`: the force on the link.
+    pub contact_n: f64,
+}
+
 /// Groups a layout's pressed cells into contacts, per link; no allocation after [`Self::new`].
 #[derive(Debug, Clone)]
 pub struct LinkContacts {
@@ -22,8 +31,8 @@ pub struct LinkContacts {
     parent: Vec<usize>,
     /// Scratch: `Σ F_i n_i` of each contact, at its root.
     sums: Vec<Vector3<f64>>,
-    /// Per model frame: the sum over the link's contacts of their `‖Σ F_i n_i‖` \[N\].
-    force_n: Vec<f64>,
+    /// Per model frame: the link's press.
+    links: Vec<LinkForce>,
 }
 
 impl LinkContacts {
@@ -46,14 +55,15 @@ impl LinkContacts {
             pressed: Vec::with_capacity(n),
             parent: Vec::with_capacity(n),
             sums: Vec::with_capacity(n),
-            force_n: vec![0.0; nframes],
+            links: vec![LinkForce::default(); nframes],
         }
     }
 
     /// Groups the cells of `forces` (layout index, measured force \[N\]) pressed this cycle (force
-    /// over 0) into contacts; returns per model frame the sum over the link's contacts of their
-    /// `‖Σ F_i n_i‖` (the norm of the link's vector sum when one thing presses it).
-    pub fn update(&mut self, layout: &ResolvedLayout, forces: impl Iterator<Item = (usize, f64)>) -> &[f64] {
+    /// over 0) into contacts; returns per model frame the link's press: the sum of its cells'
+    /// forces, and the sum over its contacts of their `‖Σ F_i n_i‖` (the norm of the link's
+    /// vector sum when one thing presses it).
+    pub fn update(&mut self, layout: &ResolvedLayout, forces: impl Iterator<Item = (usize, f64)>) -> &[LinkForce] {
         let cells = layout.cells();
         self.pressed.clear(); // within capacity: one per layout cell at most
         self.pressed.extend(forces.filter(|&(_, f)| f > 0.0));
@@ -71,16 +81,17 @@ impl LinkContacts {
         }
         self.sums.clear();
         self.sums.resize(k, Vector3::zeros());
+        self.links.fill(LinkForce::default());
         for a in 0..k {
             let (i, f) = self.pressed[a];
             let r = root(&mut self.parent, a);
             self.sums[r] += f * cells[i].normal_link;
+            self.links[cells[i].frame].pressed_n += f;
         }
-        self.force_n.fill(0.0);
         for a in (0..k).filter(|&a| self.parent[a] == a) {
-            self.force_n[cells[self.pressed[a].0].frame] += self.sums[a].norm();
+            self.links[cells[self.pressed[a].0].frame].contact_n += self.sums[a].norm();
         }
-        &self.force_n
+        &self.links
     }
 }
 

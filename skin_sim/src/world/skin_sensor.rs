@@ -9,8 +9,8 @@
 //! - Force: the contacts of one robot geom with one other geom give their summed normal force
 //!   (`mj_contactForce`), which the cells of the touched body share in proportion to how deep the
 //!   other geom presses into each cell's face (`CellFace::compression`: the soft cover's
-//!   pressure integrated over the cell); the cells' normal loads balance the force along its
-//!   direction (`SkinSensor::distribute`), and each load in newtons goes through `f(F)` on all
+//!   pressure integrated over the cell); the cells' normal loads balance the force
+//!   (`SkinSensor::distribute`), and each load in newtons goes through `f(F)` on all
 //!   three sensors. MuJoCo's contact points do not decide the split: it reports a flat contact
 //!   between boxes as corners or, tilted by a hundredth of a radian, as one edge, and split by
 //!   distance to those points a flat palm's load jumped between 8 and 3 cells. When no face is
@@ -104,10 +104,6 @@ pub(crate) struct Touch {
 
 /// Radius of the user's hand: cells this close to a touch's line of action share its force \[m\].
 pub const TOUCH_RADIUS_M: f64 = 0.05;
-
-/// Smallest `-n_i · u` a loaded cell is credited with in the force balance of
-/// [`SkinSensor::distribute`]: a cell reads at most twice the contact force.
-const MIN_FACING: f64 = 0.5;
 
 /// A sphere holding `points`: their centroid and the largest distance from it (zero radius at
 /// the origin for none).
@@ -284,9 +280,11 @@ impl SkinSensor {
     /// compression of their faces, or, with none compressed, by distance to the contact points.
     ///
     /// A cell is a rigid plate whose force sensors read the load normal to it. The loads `N_i` are
-    /// proportional to the weights and balance the contact force along its direction `u`:
-    /// `Σ N_i (-n_i · u) = |F|`. A flat palm reads `|F|` in total; two cells meeting at 45° under
-    /// a contact on their common edge each read `0.71 |F|`, as plates there would.
+    /// proportional to the weights and balance the contact force: `‖Σ N_i n_i‖ = |F|`. A flat
+    /// palm reads `|F|` in total; two cells meeting at 45° under a contact on their common edge
+    /// each read `0.71 |F|`, as plates there would. Balanced only along the force's direction,
+    /// the loads of cells on one side of a small cap (planar7's fingertip, cells 60-90° apart)
+    /// summed to up to twice the force, pushing no more than 0.5-0.7 of it (`docs/scenes.md`).
     fn distribute<M: ModelType>(&mut self, data: &MjData<M>, patch: &ContactPatch) {
         let range = self.body_range[patch.body].clone();
         let pose = body_pose(data, patch.body);
@@ -313,7 +311,7 @@ impl SkinSensor {
             self.weights.clear();
             self.weights.extend(self.by_body[range.clone()].iter().map(|&i| weight(&cells[i])));
         }
-        self.share(range, local_f.norm(), |c| -u.dot(&c.normal));
+        self.share(range, local_f.norm());
     }
 
     /// A touch's force shared by the cells of its body near its line of action (see the module
@@ -336,23 +334,19 @@ impl SkinSensor {
         };
         self.weights.clear();
         self.weights.extend(self.by_body[range.clone()].iter().map(|&i| weight(&self.cells[i])));
-        self.share(range, touch.force.norm(), |c| -u.dot(&c.normal));
+        self.share(range, touch.force.norm());
     }
 
     /// Adds `magnitude` to the cells of `range` (by-body order) in proportion to `self.weights`,
-    /// with the cells' normal loads balancing it along its direction (`facing`: `-n_i · u`).
-    fn share(&mut self, range: Range<usize>, magnitude: f64, facing: impl Fn(&SimCell) -> f64) {
-        // Nearly tangential cells count as MIN_FACING: the cover carries the rest in shear.
+    /// scaled so that the cells' normal loads balance it: `‖Σ N_i n_i‖ = |F|`.
+    fn share(&mut self, range: Range<usize>, magnitude: f64) {
         let cells = &self.cells;
-        let balance: f64 = self.by_body[range.clone()]
-            .iter()
-            .zip(&self.weights)
-            .map(|(&i, w)| w * facing(&cells[i]).max(MIN_FACING))
-            .sum();
-        if balance <= 0.0 {
+        let balance: Vector3<f64> =
+            self.by_body[range.clone()].iter().zip(&self.weights).map(|(&i, w)| cells[i].normal * *w).sum();
+        if balance.norm() <= 0.0 {
             return; // no skin there facing the force
         }
-        let scale = magnitude / balance;
+        let scale = magnitude / balance.norm();
         for (&i, w) in self.by_body[range].iter().zip(&self.weights) {
             self.force_n[i] += w * scale;
         }
@@ -399,6 +393,50 @@ mod tests {
             }
         }
         assert!(hits > 100 && culled > 0, "the scenes must both hit and cull: {hits} hits, {culled} culled");
+    }
+
+    /// The cells' normal loads balance the force of a contact: `‖Σ N_i n_i‖ = |F|` for every body
+    /// pressed by one geom, with planar7's fingertip pressed by a cylinder from 24 directions,
+    /// among them contacts where a balance along the force alone (`Σ N_i (−n_i · u) = |F|`)
+    /// differs by more than 10 %.
+    #[test]
+    fn the_loads_of_a_contact_balance_its_force() {
+        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/scenes/intentional_contact.yaml");
+        let world = World::from_scene_file(&file).unwrap();
+        let model = world.mj_model();
+        let [tip, obstacle] = ["link7", "obstacle"].map(|n| model.name_to_id(MjtObjBase::mjOBJ_BODY, n).unwrap());
+        let qpos = model.jnt_qposadr()[model.body_jntadr()[obstacle] as usize] as usize;
+        let mut sensor = world.skin().unwrap().clone();
+        let (mut checked, mut asymmetric) = (0, 0);
+        for k in 0..24 {
+            let mut data = world.mj_data().clone();
+            // the fingertip sphere (radius 0.021 m at x = 0.25 m of link7), the cylinder's side 2 mm into it
+            let center = body_pose(&data, tip) * Point3::new(0.25, 0.0, 0.0);
+            let phi = k as f64 * std::f64::consts::TAU / 24.0;
+            let at = center + Vector3::new(phi.cos(), phi.sin(), 0.0) * (0.1 + 0.021 - 0.002);
+            data.qpos_mut()[qpos..qpos + 3].copy_from_slice(&[at.x, at.y, at.z]);
+            data.forward();
+            sensor.contact_forces(&data);
+            for p in &sensor.patches {
+                if sensor.patches.iter().filter(|q| q.body == p.body).count() > 1 {
+                    continue; // loads of two contacts add up on one body
+                }
+                let pose = body_pose(&data, p.body);
+                let u = p.force.normalize();
+                let (mut sum, mut along) = (Vector3::zeros(), 0.0);
+                for &i in &sensor.by_body[sensor.body_range[p.body].clone()] {
+                    let n = pose * sensor.cells[i].normal;
+                    sum += n * sensor.force_n[i];
+                    along -= n.dot(&u) * sensor.force_n[i];
+                }
+                let f = p.force.norm();
+                assert!((sum.norm() - f).abs() <= 1e-9 * f, "direction {k}: loads {} N, force {f} N", sum.norm());
+                checked += 1;
+                asymmetric += usize::from((along - f).abs() > 0.1 * f);
+            }
+        }
+        assert!(checked >= 12, "{checked} contacts checked");
+        assert!(asymmetric > 0, "no contact where the two balances differ");
     }
 
     #[test]

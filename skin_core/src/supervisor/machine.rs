@@ -327,11 +327,13 @@ impl Supervisor {
         let fc = u.contact_force_n;
         let over = fc.is_nan() || fc >= th.contact_force_n; // NaN counts as over the limit
         let impact = fc.is_nan() || fc >= th.impact_force_n;
-        let strike = over && !self.was_over;
-        self.was_over = over;
         // A dip under ε_c shorter than the gap is no release: a force that alternates over and
-        // under ε_c from one skin sample to the next is over it (the contact's own peaks are).
-        let held = over || t - self.last_over_s <= dw.hard_contact_gap_s; // NaN: false
+        // under ε_c from one skin sample to the next is over it (the contact's own peaks are),
+        // and its rise after such a dip is no new strike.
+        let in_gap = t - self.last_over_s <= dw.hard_contact_gap_s; // NaN: false
+        let strike = over && !self.was_over && !in_gap;
+        self.was_over = over;
+        let held = over || in_gap;
         if over {
             self.last_over_s = t;
         }

@@ -116,11 +116,13 @@ declare_params! {
         /// (a)/(b) → (c): contact force over ε_c this long (0: immediate; at once from
         /// `impact_force_n`), so one skin sample's peak of a rigid touch is no hard contact.
         pub hard_contact_s: f64 => { unit: "s", range: DWELL_S, live: false },
-        /// (a)/(b) → (c) at once: `‖F_c‖` rose to ε_c again within this long of its last rise
-        /// (a contact that keeps striking ε_c is hard, however short each strike; 0: off).
+        /// (a)/(b) → (c) at once: `‖F_c‖` rose to ε_c again, after a dip longer than
+        /// `hard_contact_gap_s`, within this long of its last rise (a contact that keeps
+        /// striking ε_c is hard, however short each strike; 0: off).
         pub hard_contact_repeat_s: f64 => { unit: "s", range: DWELL_S, live: false },
         /// The `hard_contact_s` dwell survives dips of `‖F_c‖` under ε_c this short: a contact
-        /// whose force alternates over and under ε_c from one skin sample to the next is over it.
+        /// whose force alternates over and under ε_c from one skin sample to the next is over it,
+        /// and a rise after such a dip is no new strike (one impact's ringing is one strike).
         pub hard_contact_gap_s: f64 => { unit: "s", range: DWELL_S, live: false },
         /// Time constant of the average of the pressed link's advance that tells a contact that
         /// gives way (`thresholds.give_way_speed_mps`); it starts from 0 at every switch.

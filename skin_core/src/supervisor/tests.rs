@@ -192,7 +192,8 @@ fn a_push_that_made_progress_is_retried_once_per_interval() {
 /// `‖F_c‖ ≥ ε_c` is a hard contact when it lasts `hard_contact_s` (dips shorter than
 /// `hard_contact_gap_s` included), when it strikes ε_c again within `hard_contact_repeat_s` of
 /// its last strike, or at once from `impact_force_n`; one strike shorter than the dwell (a rigid
-/// touch's peak) is none.
+/// touch's peak) is none, and a rise after a dip shorter than the gap is the same strike (an
+/// impact's ringing).
 #[test]
 fn a_hard_contact_lasts_strikes_again_or_is_an_impact() {
     let p = params();
@@ -206,6 +207,9 @@ fn a_hard_contact_lasts_strikes_again_or_is_an_impact() {
     let apart = (dw.hard_contact_repeat_s / DT) as usize + 2;
     assert!(run(&mut sup, &mut t, apart, light).is_empty());
     assert!(run(&mut sup, &mut t, 1, strike).is_empty(), "a strike more than repeat_s after the last");
+    assert!(DT < dw.hard_contact_gap_s);
+    run(&mut sup, &mut t, 1, light);
+    assert!(run(&mut sup, &mut t, 1, strike).is_empty(), "a rise after a dip within the gap: the same strike");
     run(&mut sup, &mut t, 10, light);
     let tr = run(&mut sup, &mut t, 1, strike);
     let to: Vec<_> = tr.iter().map(|tr| (tr.to, tr.cause)).collect();

@@ -283,8 +283,8 @@ impl SkinSensor {
     /// proportional to the weights and balance the contact force: `‖Σ N_i n_i‖ = |F|`. A flat
     /// palm reads `|F|` in total; two cells meeting at 45° under a contact on their common edge
     /// each read `0.71 |F|`, as plates there would. Balanced only along the force's direction,
-    /// the loads of cells on one side of a small cap (planar7's fingertip, cells 60-90° apart)
-    /// summed to up to twice the force, pushing no more than 0.5-0.7 of it (`docs/scenes.md`).
+    /// the cells of a small cap (planar7's fingertip, 60-90° apart) pressed on one side read up
+    /// to twice the force (`docs/supervisor.md`, "The simulated skin reads a fingertip contact").
     fn distribute<M: ModelType>(&mut self, data: &MjData<M>, patch: &ContactPatch) {
         let range = self.body_range[patch.body].clone();
         let pose = body_pose(data, patch.body);

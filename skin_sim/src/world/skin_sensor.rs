@@ -341,12 +341,13 @@ impl SkinSensor {
     /// scaled so that the cells' normal loads balance it: `‖Σ N_i n_i‖ = |F|`.
     fn share(&mut self, range: Range<usize>, magnitude: f64) {
         let cells = &self.cells;
-        let balance: Vector3<f64> =
+        let normals: Vector3<f64> =
             self.by_body[range.clone()].iter().zip(&self.weights).map(|(&i, w)| cells[i].normal * *w).sum();
-        if balance.norm() <= 0.0 {
+        let balance = normals.norm(); // ‖Σ w_i n_i‖
+        if balance <= 0.0 {
             return; // no skin there facing the force
         }
-        let scale = magnitude / balance.norm();
+        let scale = magnitude / balance;
         for (&i, w) in self.by_body[range].iter().zip(&self.weights) {
             self.force_n[i] += w * scale;
         }

@@ -64,7 +64,10 @@ def wait_ok(proc, timeout):
 def test_lockstep_processes_reproduce_the_in_process_loop(spawn, tmp_path, reference):
     record = tmp_path / "graph.json"
     sup = spawn(binary("priority_supervisor"), "--setup", SETUP)
-    tc = spawn(binary("task_controller"), "--setup", SETUP, "--ros-args", "-p", "trigger:=inputs",
+    # The controller takes no input until the supervisor's reader is matched: states published
+    # before discovery matched it are not delivered (CI once saw 1741 of 2000 without the wait).
+    tc = spawn(binary("task_controller"), "--setup", SETUP, "--wait-topic-subscribers",
+               "/controller/state=1", "--ros-args", "-p", "trigger:=inputs",
                "-p", "supervisor:=internal", "-p", f"control_rate_hz:={RATE}")
     sim = spawn(binary("mujoco_sim"), "--scene", "intentional_contact", "--lockstep",
                 "--duration", str(DURATION), "--record", record)

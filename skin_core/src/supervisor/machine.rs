@@ -96,6 +96,10 @@ pub struct Supervisor {
     /// The hard contact (c) entered from (b) ends the push with another try (the push had got
     /// the goal nearer, and the one before did not also reach ε_c within `retry_interval_s`).
     retry: bool,
+    /// The hard contact (c) was entered from (b) with the goal within tolerance, now or when the
+    /// push began: the arm held its goal, so the contact is the environment's hit, not the
+    /// push's limit, and no [`Blocked`] hold follows it.
+    hit_at_goal: bool,
     over_limit: Dwell,
     /// `‖F_c‖ ≥ ε_c` at the last update.
     was_over: bool,
@@ -160,6 +164,7 @@ impl Supervisor {
             push_ref_error_m: f64::NAN,
             push_limit_s: f64::NAN,
             retry: false,
+            hit_at_goal: false,
             over_limit: Dwell::IDLE,
             was_over: false,
             last_strike_s: f64::NAN,
@@ -363,8 +368,13 @@ impl Supervisor {
                         // way) and the last hard contact of the push is long enough ago that the
                         // (b) → (c) switch cannot repeat more than twice in `retry_interval_s`.
                         let progress = self.push_ref_error_m - ge >= th.progress_min_m;
+                        // At its goal when this push began (or at its last hard contact), or
+                        // now, the arm pushed nothing: the contact struck it, and there is no
+                        // progress to ask of the arm.
+                        let tol = th.goal_tolerance_m;
+                        self.hit_at_goal = self.push_ref_error_m <= tol || ge <= tol; // NaN: false
                         let spaced = self.retry_spaced(t);
-                        self.retry = progress && spaced;
+                        self.retry = (progress || self.hit_at_goal) && spaced;
                         self.push_ref_error_m = ge;
                         self.push_limit_s = t;
                     }
@@ -447,7 +457,11 @@ impl Supervisor {
                     if to_b {
                         // The obstacle gave way before the push reached ε_c: push on.
                         self.switch(t, Mode::IntentionalContact, Cause::ContactReleased);
-                    } else if self.resume == Mode::IntentionalContact {
+                    } else if pushed && self.hit_at_goal {
+                        // Hit again too soon at the goal: (a), where stuck detection starts the
+                        // next push once the hits have stopped; nothing of the arm's is blocked.
+                        self.switch(t, Mode::Avoidance, Cause::ContactReleased);
+                    } else if pushed {
                         // The push of (b) reached ε_c without getting the goal nearer (or again
                         // too soon): pushing again would only hit ε_c again (the (b) <-> (c)
                         // cycle of a fixed or too heavy obstacle).

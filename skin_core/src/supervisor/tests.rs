@@ -267,6 +267,31 @@ fn a_force_flickering_over_eps_c_sample_by_sample_lasts() {
     assert!(t - t0 >= dw.hard_contact_s && t - t0 <= dw.hard_contact_s + 3.0 * DT, "after the dwell: {}", t - t0);
 }
 
+/// A hard contact that strikes the arm while it holds its goal in (b) (an obstacle pushed into
+/// it) is no push that failed: released, the arm goes back to (b); struck again within
+/// `retry_interval_s`, now knocked off its goal, it goes to (a), not held blocked, so stuck
+/// detection can start the push back to the goal.
+#[test]
+fn a_hit_at_the_goal_is_no_blocked_push() {
+    let p = params();
+    let tol = p.thresholds.goal_tolerance_m;
+    let (mut sup, mut t) = in_b(&p);
+    assert!(
+        run(&mut sup, &mut t, 500, input(0.0, 3.0, 0.5, 0.5 * tol)).is_empty(),
+        "at the goal, obstacle in range: (b)"
+    );
+    let tr = run(&mut sup, &mut t, held(&p), input(0.0, 3.0, 8.0, 0.5 * tol));
+    assert_eq!((tr[0].to, tr[0].cause), (Mode::HardContact, Cause::ContactOverLimit));
+    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 2.0 * tol));
+    assert_eq!((tr[0].to, tr[0].cause), (Mode::IntentionalContact, Cause::ContactReleased));
+    run(&mut sup, &mut t, held(&p), input(0.0, 3.0, 8.0, 3.0 * tol));
+    let tr = run(&mut sup, &mut t, 200, input(0.0, 3.0, 0.0, 3.0 * tol));
+    assert_eq!((tr[0].to, tr[0].cause), (Mode::Avoidance, Cause::ContactReleased));
+    assert_eq!(sup.blocked(), None);
+    assert!(!sup.releasing());
+    into_b(&mut sup, &mut t);
+}
+
 /// A push in (b) that gets the goal less than `progress_min_m` nearer in `push_stall_s` (it
 /// stalls, or its contact flickers under the hard-contact rules) is given up as one that reached
 /// ε_c: (a), held, pressing nothing; a push that gains on the goal slowly goes on.

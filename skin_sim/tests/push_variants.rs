@@ -78,13 +78,23 @@ fn a_fixed_obstacle_is_pushed_at_most_twice_then_the_arm_holds_blocked() {
     assert!(checks.iter().all(|c| c.passed), "{checks:?}");
 }
 
-/// 1-1.5 kg slide under eps_c once moving (friction 2-2.9 N) and 2-3 kg do not; every one ends
-/// safe, with at most two pushes that reach eps_c (a retry of a push that made progress).
+/// 1-3 kg (friction 2-5.9 N): every one ends safe, with at most two pushes that reach eps_c (a
+/// retry of a push that made progress). An arm that had its goal when the scripted push at 15 s
+/// threw the obstacle into it may end dodging the thrown obstacle in (a), not blocked (2 kg: the
+/// goal within 0.9 mm at 15 s, both hard contacts hits at the goal, 17.8 mm off at 20 s).
 #[test]
 fn heavier_obstacles_end_safely() {
     for kg in [1.0, 1.5, 2.0, 3.0] {
         let r = run_variant(|s| s.spec.objects[0].mass_kg = Some(kg));
-        assert_safe(&format!("{kg} kg"), &r);
+        let name = format!("{kg} kg");
+        let goal = r.metrics.goal.as_ref().expect("goal metrics");
+        let had_goal = goal.goal_error_before_pushes_m <= goal.goal_tolerance_m; // NaN (no push): false
+        if had_goal {
+            let v = safety::violations(&r.metrics.safety, r.metrics.faulted_cycles);
+            assert!(v.is_empty(), "{name}: {v:?}; switches {:?}", r.record.switches);
+        } else {
+            assert_safe(&name, &r);
+        }
         assert!(hard_contacts_from_b(&r) <= 2, "{kg} kg: {:?}", r.record.switches);
     }
 }

@@ -33,9 +33,13 @@ fn outcome(r: &RunReport) -> &'static str {
     r.metrics.goal.as_ref().expect("goal metrics").outcome
 }
 
-fn assert_safe(name: &str, r: &RunReport) {
+fn assert_no_violations(name: &str, r: &RunReport) {
     let v = safety::violations(&r.metrics.safety, r.metrics.faulted_cycles);
     assert!(v.is_empty(), "{name}: {v:?}; switches {:?}", r.record.switches);
+}
+
+fn assert_safe(name: &str, r: &RunReport) {
+    assert_no_violations(name, r);
     let o = outcome(r);
     assert!(o == "reached" || o == "blocked", "{name}: outcome {o}");
 }
@@ -90,8 +94,7 @@ fn heavier_obstacles_end_safely() {
         let goal = r.metrics.goal.as_ref().expect("goal metrics");
         let had_goal = goal.goal_error_before_pushes_m <= goal.goal_tolerance_m; // NaN (no push): false
         if had_goal {
-            let v = safety::violations(&r.metrics.safety, r.metrics.faulted_cycles);
-            assert!(v.is_empty(), "{name}: {v:?}; switches {:?}", r.record.switches);
+            assert_no_violations(&name, &r);
         } else {
             assert_safe(&name, &r);
         }

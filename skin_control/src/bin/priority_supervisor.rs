@@ -35,5 +35,6 @@ fn main() -> Result<()> {
     // Nothing delivered is lost on a stop: the dwell timers and the switch log count every state.
     nodes::drain(&mut node, &mut pool, || handle.states_taken(), Duration::from_secs(2));
     handle.stop();
+    shutdown::bound_teardown(0);
     Ok(())
 }

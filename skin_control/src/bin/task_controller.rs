@@ -72,5 +72,6 @@ fn main() -> Result<()> {
     while std::time::Instant::now() < until {
         node.spin_once(std::time::Duration::from_millis(50));
     }
+    shutdown::bound_teardown(0);
     Ok(())
 }

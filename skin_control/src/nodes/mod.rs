@@ -78,13 +78,18 @@ impl<const N: usize> OnceLog<N> {
 /// A binary's exit code (skin_sim's convention): 0, 1 when an outcome check failed
 /// (`Some(false)`), 2 when the run failed (the error is printed).
 pub fn exit_code(binary: &str, run: Result<Option<bool>>) -> std::process::ExitCode {
+    if let Err(e) = &run {
+        eprintln!("{binary}: {e:#}");
+    }
+    std::process::ExitCode::from(code(&run))
+}
+
+/// The number [`exit_code`] gives `run`.
+pub fn code(run: &Result<Option<bool>>) -> u8 {
     match run {
-        Ok(Some(false)) => std::process::ExitCode::from(1),
-        Ok(_) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("{binary}: {e:#}");
-            std::process::ExitCode::from(2)
-        }
+        Ok(Some(false)) => 1,
+        Ok(_) => 0,
+        Err(_) => 2,
     }
 }
 

@@ -214,5 +214,6 @@ pub fn main() -> Result<()> {
         "stopping after {} messages: aggregation {aggregation}, with publishing {cycle}; bad input: {issues}; messages refused: {refused}",
         cycle.count
     );
+    shutdown::bound_teardown(0);
     Ok(())
 }

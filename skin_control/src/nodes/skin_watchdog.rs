@@ -222,5 +222,6 @@ pub fn main() -> Result<()> {
         }
     }
     r2r::log_info!(&logger, "stopping after {} trips", dog.trips());
+    shutdown::bound_teardown(0);
     Ok(())
 }

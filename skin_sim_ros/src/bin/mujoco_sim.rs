@@ -57,8 +57,10 @@ fn run() -> Result<Option<bool>> {
     });
     let outcome = handle.stop()?;
     node.spin_once(std::time::Duration::from_millis(50));
-    match failure {
+    let run = match failure {
         Some(e) => Err(e.context("publishing")),
         None => Ok(outcome),
-    }
+    };
+    shutdown::bound_teardown(nodes::code(&run).into());
+    run
 }

@@ -10,6 +10,7 @@ import os
 import signal
 import subprocess
 import sys
+import warnings
 import xml.etree.ElementTree as ET
 
 import pytest
@@ -49,6 +50,11 @@ class Launch:
         self.proc.send_signal(signal.SIGINT)
         rc = self.proc.wait(timeout=timeout)
         _, alive = psutil.wait_procs(children, timeout=timeout)
+        # A node whose middleware teardown hung was ended by its bound (shutdown::bound_teardown):
+        # the stop is clean, but the hang is worth seeing in the run's warnings.
+        for line in self.output().splitlines():
+            if "teardown did not end" in line:
+                warnings.warn(line)
         return rc, alive
 
     def wait_for(self, node, predicate, what, timeout=90.0):

@@ -84,8 +84,15 @@ pub fn exit_code(binary: &str, run: Result<Option<bool>>) -> std::process::ExitC
     std::process::ExitCode::from(code(&run))
 }
 
+/// `run`, the result of a binary whose work is done: its teardown from here on is bounded, ending
+/// with the code [`exit_code`] gives `run` ([`crate::shutdown::bound_teardown`]).
+pub fn bounded(run: Result<Option<bool>>) -> Result<Option<bool>> {
+    crate::shutdown::bound_teardown(code(&run).into());
+    run
+}
+
 /// The number [`exit_code`] gives `run`.
-pub fn code(run: &Result<Option<bool>>) -> u8 {
+fn code(run: &Result<Option<bool>>) -> u8 {
     match run {
         Ok(Some(false)) => 1,
         Ok(_) => 0,

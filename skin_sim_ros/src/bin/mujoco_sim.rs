@@ -57,10 +57,8 @@ fn run() -> Result<Option<bool>> {
     });
     let outcome = handle.stop()?;
     node.spin_once(std::time::Duration::from_millis(50));
-    let run = match failure {
+    nodes::bounded(match failure {
         Some(e) => Err(e.context("publishing")),
         None => Ok(outcome),
-    };
-    shutdown::bound_teardown(nodes::code(&run).into());
-    run
+    })
 }

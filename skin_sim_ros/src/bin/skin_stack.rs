@@ -142,10 +142,8 @@ fn run() -> Result<Option<bool>> {
     sup.stop();
     let outcome = sim.map(|s| s.stop()).transpose()?.flatten();
     tc_node.spin_once(std::time::Duration::from_millis(50));
-    let run = match failure {
+    nodes::bounded(match failure {
         Some(e) => Err(e.context("mujoco_sim")),
         None => Ok(outcome),
-    };
-    shutdown::bound_teardown(nodes::code(&run).into());
-    run
+    })
 }

@@ -13,7 +13,7 @@ import subprocess
 import pytest
 from rosbags.highlevel import AnyReader
 
-from conftest import binary
+from conftest import TOP, binary
 
 DURATION = 2.0
 PERIODS = int(DURATION * 500)  # the scene's control rate
@@ -72,3 +72,14 @@ def test_graph_run_bag_reads_with_rosbags(runs):
     assert counts.get("/robot_description") == 1 and counts.get("/tf", 0) >= 1 and counts.get("/skin/markers", 0) >= 1, counts
     metrics = json.loads((graph_dir / "metrics.json").read_text())
     assert last_state.goal_error == pytest.approx(metrics["goal_error_m"], abs=1e-12)
+
+
+def test_demo_names_a_node_left_on_its_domain(rclpy_node):
+    """scripts/domain_nodes.py, which `make demo` runs before its graph run, lists a node another
+    run left on the domain (here the rclpy peer), and not itself."""
+    script = TOP / "scripts" / "domain_nodes.py"
+    listed = subprocess.run(["python3", str(script), "--wait-s", "2"], capture_output=True, text=True, timeout=60)
+    assert listed.returncode == 0, listed.stderr
+    names = listed.stdout.split()
+    assert f"/{rclpy_node.get_name()}" in names, listed.stdout
+    assert not any("domain_probe" in n for n in names), names

@@ -7,7 +7,7 @@ use crate::model::{point_jacobian_along, ModelData, ModelError, RobotModel};
 use crate::resolver::{ApproachParams, ClosingBounds};
 use crate::skin::aggregate::FusionParams;
 use crate::skin::characteristic::PreparedForce;
-use crate::skin::contacts::LinkContacts;
+use crate::skin::contacts::{LinkContacts, LinkForce};
 use crate::skin::layout::ResolvedLayout;
 use crate::skin::live::LiveCells;
 use crate::supervisor::Thresholds;
@@ -48,9 +48,8 @@ pub(crate) struct ApproachBound {
     params: ApproachParams,
     levels: ContactLevels,
     force: PreparedForce,
-    /// Per model frame: the speed at contact of the link's cells \[m/s\] (0 up to
-    /// `push_speed_max_mps` in a push, regulated by the link's force).
-    push_mps: Vec<f64>,
+    /// Per model frame: the link's push.
+    pushes: Vec<LinkPush>,
     /// The links' contacts: their forces this cycle.
     contacts: LinkContacts,
     /// Scratch per live cell: its measured force this cycle \[N\] (0 below the threshold).
@@ -75,7 +74,7 @@ impl ApproachBound {
             params,
             levels,
             force,
-            push_mps: vec![params.speed_min_mps; nframes],
+            pushes: vec![LinkPush::at(params.speed_min_mps); nframes],
             contacts: LinkContacts::new(layout, nframes),
             forces_n: Vec::with_capacity(cells),
             row: vec![0.0; nv],
@@ -100,9 +99,11 @@ impl ApproachBound {
     ///   when one thing presses it), about its push force `F_p = ε_c − push_margin_n`:
     ///   under it, growing by `push_force_gain_mps2_per_n · (F_p − F)` per second, at most
     ///   `push_accel_mps2`, up to `push_speed_max_mps`: it pushes something that slides (a push
-    ///   at the touch speed would take 10 s for 20 cm); over it, at once at most the touch speed
-    ///   and falling by the gain times the excess, down to 0: a link that pushes what does not
-    ///   give way holds `F_p`, under `ε_c` by the margin a skin that reads low needs
+    ///   at the touch speed would take 10 s for 20 cm); over it, falling by the gain times the
+    ///   excess, down to 0, and at once at most the touch speed unless the excess is a
+    ///   stick-slip peak (over `F_p` for at most `push_peak_s`, risen by less than `ε_c − F_p`
+    ///   since the cycle before): a link that pushes what does not give way holds `F_p`, under
+    ///   `ε_c` by the margin a skin that reads low needs, and a push that slides keeps going
     ///   (`docs/resolver.md`). Falling back to the touch speed when the pushed thing slid ahead
     ///   out of contact (its cells' forces sum to no contact);
     /// - otherwise the touch speed `speed_min_mps`.
@@ -128,23 +129,14 @@ impl ApproachBound {
             self.forces_n.push(fusion.cell_force_n(reading, &self.force).unwrap_or(0.0));
         }
         let dt = if dt_s.is_finite() { dt_s.max(0.0) } else { 0.0 };
-        let (touch, fastest, accel, gain) =
-            (p.speed_min_mps, p.push_speed_max_mps, p.push_accel_mps2, p.push_force_gain_mps2_per_n);
         if intent == ContactIntent::Push {
             let ids = cells.cells().iter().map(|(i, _)| *i);
             let links = self.contacts.update(layout, ids.zip(self.forces_n.iter().copied()));
-            for (v, link) in self.push_mps.iter_mut().zip(links) {
-                let f = link.contact_n;
-                *v = if link.pressed_n <= levels.zero_n {
-                    (*v - accel * dt).max(touch) // a pushed object that slid ahead: the push goes on
-                } else if f <= levels.push_n {
-                    (*v + dt * accel.min(gain * (levels.push_n - f))).min(fastest)
-                } else {
-                    (v.min(touch) - dt * gain * (f - levels.push_n)).max(0.0)
-                };
+            for (push, link) in self.pushes.iter_mut().zip(links) {
+                push.regulate(*link, p, &levels, dt);
             }
         } else {
-            self.push_mps.fill(touch);
+            self.pushes.fill(LinkPush::at(p.speed_min_mps));
         }
         let range = cells.proximity_range_m();
         // a cell without proximity signal is at the range: it senses nothing
@@ -154,11 +146,48 @@ impl ApproachBound {
             }
             let cell = &layout.cells()[*i];
             let at_limit = f >= levels.limit_n;
-            let contact = if intent == ContactIntent::Release || at_limit { 0.0 } else { self.push_mps[cell.frame] };
+            let contact =
+                if intent == ContactIntent::Release || at_limit { 0.0 } else { self.pushes[cell.frame].speed_mps };
             let outward = data.frame_pose(cell.frame).rotation * cell.normal_link;
             point_jacobian_along(model, data, cell.frame, &cell.position_link, &outward, &mut self.row)?;
             bounds.push(&self.row, contact + d / p.time_s);
         }
         Ok(())
+    }
+}
+
+/// One link's push regulator (the speed at contact of [`ApproachBound::update`]).
+#[derive(Debug, Clone, Copy)]
+struct LinkPush {
+    /// The speed at contact of the link's cells \[m/s\]: 0 up to `push_speed_max_mps`.
+    speed_mps: f64,
+    /// The link's force the cycle before \[N\].
+    last_n: f64,
+    /// How long the link's force has been over its push force \[s\].
+    over_s: f64,
+}
+
+impl LinkPush {
+    /// At `speed_mps`, out of contact.
+    fn at(speed_mps: f64) -> Self {
+        Self { speed_mps, last_n: 0.0, over_s: 0.0 }
+    }
+
+    /// One cycle of the push with the link's force `link`, `dt_s` after the last.
+    fn regulate(&mut self, link: LinkForce, p: &ApproachParams, levels: &ContactLevels, dt_s: f64) {
+        let (f, v) = (link.contact_n, self.speed_mps);
+        let rise = f - std::mem::replace(&mut self.last_n, f);
+        self.over_s = if f > levels.push_n { self.over_s + dt_s } else { 0.0 };
+        self.speed_mps = if link.pressed_n <= levels.zero_n {
+            (v - p.push_accel_mps2 * dt_s).max(p.speed_min_mps) // a pushed object that slid ahead: the push goes on
+        } else if f <= levels.push_n {
+            (v + dt_s * p.push_accel_mps2.min(p.push_force_gain_mps2_per_n * (levels.push_n - f)))
+                .min(p.push_speed_max_mps)
+        } else {
+            // a peak: brief, and one more such rise would not reach eps_c
+            let peak = self.over_s <= p.push_peak_s && rise < levels.limit_n - levels.push_n;
+            let from = if peak { v } else { v.min(p.speed_min_mps) };
+            (from - dt_s * p.push_force_gain_mps2_per_n * (f - levels.push_n)).max(0.0)
+        };
     }
 }

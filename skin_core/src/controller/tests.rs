@@ -406,7 +406,9 @@ fn no_skin_point_closes_on_a_sensed_surface_faster_than_the_approach_bound() {
 /// link's force `F = ‖Σ F_i n_i‖` about its push force `F_p = ε_c − push_margin_n`: from the
 /// touch speed, growing by the push acceleration while `F` is far under `F_p` and by the gain
 /// times `F_p − F` near it, up to the fastest push; over `F_p` at once the touch speed, falling
-/// by the gain times the excess down to 0 (a push that does not give way holds `F_p`); the link's
+/// by the gain times the excess down to 0 (a push that does not give way holds `F_p`), unless
+/// the excess is a stick-slip peak (over `F_p` for at most `push_peak_s`, risen by less than
+/// `ε_c − F_p` in a cycle), which only slows the push by the gain; the link's
 /// force, not its hardest cell; falling back by the acceleration out of contact; the touch speed
 /// in any other arrangement; 0 for a cell at `ε_c` and when the contact is to be released.
 #[test]
@@ -487,6 +489,30 @@ fn a_push_regulates_its_links_force_under_eps_c() {
     }
     assert_eq!(v, 0.0, "a push that does not give way holds its force: nothing closes");
     assert!(close(step2(far, 0.0, ContactIntent::Push).0, a * dt), "under the push force again: the push resumes");
+    // a fast push whose force rises slowly over F_p: a peak, then, held, a stop
+    for _ in 0..((fastest / (a * dt)) as usize) {
+        step2(far, 0.0, ContactIntent::Push);
+    }
+    let margin = th.contact_force_n - push_n;
+    let mut v = step2(push_n - 0.1 * margin, 0.0, ContactIntent::Push).0;
+    assert!(v > touch + k * margin * dt * 10.0, "a fast push ({v} m/s)");
+    for n in 1..=((p.push_peak_s / dt) as usize + 2) {
+        let got = step2(push_n + over, 0.0, ContactIntent::Push).0;
+        let held_s = n as f64 * dt;
+        if held_s < p.push_peak_s - 0.5 * dt {
+            assert!(close(got, v - k * over * dt), "a peak over the push force, {held_s} s: {got}, from {v}");
+        } else if held_s > p.push_peak_s + 0.5 * dt {
+            assert!(got <= touch, "over the push force for {held_s} s: a stop, {got} m/s");
+        }
+        v = got;
+    }
+    step2(push_n - 0.1 * margin, 0.0, ContactIntent::Push);
+    for _ in 0..((fastest / (a * dt)) as usize) {
+        step2(far, 0.0, ContactIntent::Push);
+    }
+    let got = step2(push_n + over, 0.0, ContactIntent::Push).0;
+    assert!(far + margin < push_n + over && got <= touch, "a rise of the margin in a cycle: a stop, {got} m/s");
+    step2(0.0, 0.0, ContactIntent::Push);
     // two cells of one contact, each under the push force: their link's force is over it
     let f = 0.6 * push_n;
     let link_n = (f * (cell(pressed).normal_link + cell(beside).normal_link)).norm();

@@ -52,6 +52,11 @@ declare_params! {
         /// newton of the link's force under (up to `push_accel_mps2`) or over its push force.
         #[serde(default = "default_push_force_gain")]
         pub push_force_gain_mps2_per_n: f64 => { unit: "m/s² per N", range: Range::closed(0.0, 100.0), live: false },
+        /// A link's force over its push force for at most this long, risen by less than the
+        /// push margin since the cycle before, is a stick-slip peak of what it pushes: the
+        /// regulator slows the push by its gain instead of setting it back to the touch speed.
+        #[serde(default = "default_push_peak")]
+        pub push_peak_s: f64 => { unit: "s", range: Range::closed(0.0, 10.0), live: false },
     }
 }
 
@@ -67,6 +72,10 @@ fn default_push_force_gain() -> f64 {
     ApproachParams::default().push_force_gain_mps2_per_n
 }
 
+fn default_push_peak() -> f64 {
+    ApproachParams::default().push_peak_s
+}
+
 impl Default for ApproachParams {
     /// The shipped values (`config/resolver.yaml`).
     fn default() -> Self {
@@ -77,6 +86,7 @@ impl Default for ApproachParams {
             push_accel_mps2: 0.1,
             push_speed_max_mps: 0.1,
             push_force_gain_mps2_per_n: 0.1,
+            push_peak_s: 0.02,
         }
     }
 }

@@ -101,10 +101,9 @@ impl ApproachBound {
     ///   `push_accel_mps2`, up to `push_speed_max_mps`: it pushes something that slides (a push
     ///   at the touch speed would take 10 s for 20 cm); over it, falling by the gain times the
     ///   excess, down to 0, and at once at most the touch speed unless the excess is a
-    ///   stick-slip peak (over `F_p` for at most `push_peak_s`, risen by less than `ε_c − F_p`
-    ///   since the cycle before): a link that pushes what does not give way holds `F_p`, under
-    ///   `ε_c` by the margin a skin that reads low needs, and a push that slides keeps going
-    ///   (`docs/resolver.md`). Falling back to the touch speed when the pushed thing slid ahead
+    ///   stick-slip peak (over `F_p` for at most `push_peak_s`, and under `ε_c`): a link that
+    ///   pushes what does not give way holds `F_p`, under `ε_c` by the margin a skin that reads
+    ///   low needs, and a push that slides keeps going (`docs/resolver.md`). Falling back to the touch speed when the pushed thing slid ahead
     ///   out of contact (its cells' forces sum to no contact);
     /// - otherwise the touch speed `speed_min_mps`.
     #[allow(clippy::too_many_arguments)]
@@ -161,8 +160,6 @@ impl ApproachBound {
 struct LinkPush {
     /// The speed at contact of the link's cells \[m/s\]: 0 up to `push_speed_max_mps`.
     speed_mps: f64,
-    /// The link's force the cycle before \[N\].
-    last_n: f64,
     /// How long the link's force has been over its push force \[s\].
     over_s: f64,
 }
@@ -170,13 +167,12 @@ struct LinkPush {
 impl LinkPush {
     /// At `speed_mps`, out of contact.
     fn at(speed_mps: f64) -> Self {
-        Self { speed_mps, last_n: 0.0, over_s: 0.0 }
+        Self { speed_mps, over_s: 0.0 }
     }
 
     /// One cycle of the push with the link's force `link`, `dt_s` after the last.
     fn regulate(&mut self, link: LinkForce, p: &ApproachParams, levels: &ContactLevels, dt_s: f64) {
         let (f, v) = (link.contact_n, self.speed_mps);
-        let rise = f - std::mem::replace(&mut self.last_n, f);
         self.over_s = if f > levels.push_n { self.over_s + dt_s } else { 0.0 };
         self.speed_mps = if link.pressed_n <= levels.zero_n {
             (v - p.push_accel_mps2 * dt_s).max(p.speed_min_mps) // a pushed object that slid ahead: the push goes on
@@ -184,8 +180,8 @@ impl LinkPush {
             (v + dt_s * p.push_accel_mps2.min(p.push_force_gain_mps2_per_n * (levels.push_n - f)))
                 .min(p.push_speed_max_mps)
         } else {
-            // a peak: brief, and one more such rise would not reach eps_c
-            let peak = self.over_s <= p.push_peak_s && rise < levels.limit_n - levels.push_n;
+            // a stick-slip peak is brief and under eps_c; a stop lasts, a strike reaches eps_c
+            let peak = self.over_s <= p.push_peak_s && f < levels.limit_n;
             let from = if peak { v } else { v.min(p.speed_min_mps) };
             (from - dt_s * p.push_force_gain_mps2_per_n * (f - levels.push_n)).max(0.0)
         };

@@ -52,9 +52,9 @@ declare_params! {
         /// newton of the link's force under (up to `push_accel_mps2`) or over its push force.
         #[serde(default = "default_push_force_gain")]
         pub push_force_gain_mps2_per_n: f64 => { unit: "m/s² per N", range: Range::closed(0.0, 100.0), live: false },
-        /// A link's force over its push force for at most this long, risen by less than the
-        /// push margin since the cycle before, is a stick-slip peak of what it pushes: the
-        /// regulator slows the push by its gain instead of setting it back to the touch speed.
+        /// A link's force over its push force for at most this long, and under `ε_c`, is a
+        /// stick-slip peak of what it pushes: the regulator slows the push by its gain instead
+        /// of setting it back to the touch speed.
         #[serde(default = "default_push_peak")]
         pub push_peak_s: f64 => { unit: "s", range: Range::closed(0.0, 10.0), live: false },
     }

@@ -103,8 +103,9 @@ impl ApproachBound {
     ///   excess, down to 0, and at once at most the touch speed unless the excess is a
     ///   stick-slip peak (over `F_p` for at most `push_peak_s`, and under `ε_c`): a link that
     ///   pushes what does not give way holds `F_p`, under `ε_c` by the margin a skin that reads
-    ///   low needs, and a push that slides keeps going (`docs/resolver.md`). Falling back to the touch speed when the pushed thing slid ahead
-    ///   out of contact (its cells' forces sum to no contact);
+    ///   low needs, and a push that slides keeps going (`docs/resolver.md`). Falling back to the
+    ///   touch speed when the pushed thing slid ahead out of contact (its cells' forces sum to no
+    ///   contact);
     /// - otherwise the touch speed `speed_min_mps`.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn update(

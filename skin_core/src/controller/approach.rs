@@ -3,11 +3,10 @@
 //! distance and force, as a limit the resolver meets. A link that pushes something that gives
 //! way pushes faster than it touches, and holds its force under `ε_c`.
 
+use super::press::Press;
 use crate::model::{point_jacobian_along, ModelData, ModelError, RobotModel};
 use crate::resolver::{ApproachParams, ClosingBounds};
-use crate::skin::aggregate::FusionParams;
-use crate::skin::characteristic::PreparedForce;
-use crate::skin::contacts::{LinkContacts, LinkForce};
+use crate::skin::contacts::LinkForce;
 use crate::skin::layout::ResolvedLayout;
 use crate::skin::live::LiveCells;
 use crate::supervisor::Thresholds;
@@ -47,56 +46,49 @@ impl ContactLevels {
 pub(crate) struct ApproachBound {
     params: ApproachParams,
     levels: ContactLevels,
-    force: PreparedForce,
     /// Per model frame: the link's push.
     pushes: Vec<LinkPush>,
-    /// The links' contacts: their forces this cycle.
-    contacts: LinkContacts,
-    /// Scratch per live cell: its measured force this cycle \[N\] (0 below the threshold).
-    forces_n: Vec<f64>,
+    /// Number of cells of the layout: at most one limit each.
+    cells: usize,
     /// Scratch: one cell's row.
     row: Vec<f64>,
 }
 
 impl ApproachBound {
-    /// The bound on a model with `nv` joints and `nframes` frames and the skin `layout`; the
-    /// contact `levels` are read through `force`.
+    /// The bound on a model with `nv` joints and `nframes` frames and the skin `layout`, at the
+    /// contact `levels`.
     pub(crate) fn new(
         params: ApproachParams,
         levels: ContactLevels,
-        force: PreparedForce,
         nv: usize,
         nframes: usize,
         layout: &ResolvedLayout,
     ) -> Self {
-        let cells = layout.num_cells();
         Self {
             params,
             levels,
-            force,
             pushes: vec![LinkPush::at(params.speed_min_mps); nframes],
-            contacts: LinkContacts::new(layout, nframes),
-            forces_n: Vec::with_capacity(cells),
+            cells: layout.num_cells(),
             row: vec![0.0; nv],
         }
     }
 
     /// Room for the limits of every cell of the layout.
     pub(crate) fn limits(&self) -> ClosingBounds {
-        let rows = if self.params.enabled { self.forces_n.capacity() } else { 0 };
+        let rows = if self.params.enabled { self.cells } else { 0 };
         ClosingBounds::with_capacity(self.row.len(), rows)
     }
 
-    /// Sets `bounds` to the limits for the cells' readings at the state of the last kinematics
-    /// update, `dt_s` after the last: the outward normal's row (closing is positive) and
+    /// Sets `bounds` to the limits for the live `cells` and their `press` at the state of the last
+    /// kinematics update, `dt_s` after the last: the outward normal's row (closing is positive) and
     /// `v_c + d / time` for distance `d`. The speed at contact `v_c` of a link's cells is
     /// - 0 for a cell pressed at `ε_c` or more, and in a hard contact and the hold after a push
     ///   given up ([`ContactIntent::Release`]): nothing drives the body back into a contact the
     ///   reaction relieves (the goal below the reaction did, a limit cycle of touches for the rest
     ///   of the run);
     /// - in a push ([`ContactIntent::Push`]), regulated by the link's force `F`, the sum over its
-    ///   contacts of their `‖Σ F_i n_i‖` ([`LinkContacts`]; the supervisor's `‖F_c‖` of the link
-    ///   when one thing presses it), about its push force `F_p = ε_c − push_margin_n`:
+    ///   contacts of their `‖Σ F_i n_i‖` ([`Press`]; the supervisor's `‖F_c‖` is the largest
+    ///   link's), about its push force `F_p = ε_c − push_margin_n`:
     ///   under it, growing by `push_force_gain_mps2_per_n · (F_p − F)` per second, at most
     ///   `push_accel_mps2`, up to `push_speed_max_mps`: it pushes something that slides (a push
     ///   at the touch speed would take 10 s for 20 cm); over it, falling by the gain times the
@@ -114,7 +106,7 @@ impl ApproachBound {
         data: &ModelData,
         layout: &ResolvedLayout,
         cells: &LiveCells,
-        fusion: &FusionParams,
+        press: &Press,
         intent: ContactIntent,
         dt_s: f64,
         bounds: &mut ClosingBounds,
@@ -124,15 +116,9 @@ impl ApproachBound {
             return Ok(());
         }
         let (p, levels) = (&self.params, self.levels);
-        self.forces_n.clear(); // within capacity: one per layout cell at most
-        for (_, reading) in cells.cells() {
-            self.forces_n.push(fusion.cell_force_n(reading, &self.force).unwrap_or(0.0));
-        }
         let dt = if dt_s.is_finite() { dt_s.max(0.0) } else { 0.0 };
         if intent == ContactIntent::Push {
-            let ids = cells.cells().iter().map(|(i, _)| *i);
-            let links = self.contacts.update(layout, ids.zip(self.forces_n.iter().copied()));
-            for (push, link) in self.pushes.iter_mut().zip(links) {
+            for (push, link) in self.pushes.iter_mut().zip(press.links()) {
                 push.regulate(*link, p, &levels, dt);
             }
         } else {
@@ -140,7 +126,7 @@ impl ApproachBound {
         }
         let range = cells.proximity_range_m();
         // a cell without proximity signal is at the range: it senses nothing
-        for (((i, _), &d), &f) in cells.cells().iter().zip(cells.distances()).zip(&self.forces_n) {
+        for (((i, _), &d), &f) in cells.cells().iter().zip(cells.distances()).zip(press.cell_forces_n()) {
             if d >= range {
                 continue;
             }

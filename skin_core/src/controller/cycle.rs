@@ -4,6 +4,7 @@ use nalgebra::{DMatrix, DVector, Isometry3};
 
 use super::approach::{ApproachBound, ContactIntent, ContactLevels};
 use super::io::{ControllerInput, ControllerOutput, Fault};
+use super::press::Press;
 use super::setup::{ControllerConfig, HierarchyDynamics, SetupError};
 use super::stages::{Stage, StageClock, StageTimes};
 use super::task_set::TaskSet;
@@ -62,6 +63,8 @@ pub struct Controller {
     /// The commanded base motion, if any.
     base_reference: Option<BaseReference>,
     solver: HierarchySolver,
+    /// This cycle's measured cell forces and the force on each link.
+    press: Press,
     /// The skin's approach bound on the command (`docs/resolver.md`).
     approach: ApproachBound,
     resolver: Resolver,
@@ -149,7 +152,8 @@ impl Controller {
             .map_err(|error| SetupError::Resolver { file: config.setup.resolver.display().to_string(), error })?;
         let levels = ContactLevels::of(&config.supervisor.thresholds);
         let force = config.skin.force.prepared();
-        let approach = ApproachBound::new(config.resolver.approach, levels, force, nv, model.nframes(), &config.layout);
+        let press = Press::new(force, &config.layout, model.nframes());
+        let approach = ApproachBound::new(config.resolver.approach, levels, nv, model.nframes(), &config.layout);
         *resolver.closing_bounds_mut() = approach.limits();
         let supervisor = Supervisor::new(&config.supervisor, t0_s)?;
         let output = ControllerOutput {
@@ -168,6 +172,7 @@ impl Controller {
         Ok(Controller {
             data: ModelData::new(model),
             solver,
+            press,
             approach,
             resolver,
             blender: TorqueBlender::new(nv),
@@ -506,10 +511,10 @@ impl Controller {
             Mode::IntentionalContact => ContactIntent::Push,
             _ => ContactIntent::Touch,
         };
-        let live = &self.live;
+        let (live, press) = (&self.live, &self.press);
         let bounds = self.resolver.closing_bounds_mut();
         self.approach
-            .update(model, &self.data, layout, live, &self.fusion, intent, input.dt_s, bounds)
+            .update(model, &self.data, layout, live, press, intent, input.dt_s, bounds)
             .map_err(stage("approach bound"))?;
         self.resolver
             .update(self.tau.as_slice(), self.gravity.as_slice(), input.q, input.qd, input.dt_s)
@@ -528,6 +533,7 @@ impl Controller {
         let avoid = self.proximity_signal.summarize(layout, &self.live, nominal).map_err(stage("avoidance"))?;
         let contact =
             self.contact_signal.summarize(layout, &self.live, &skin.fusion).map_err(stage("contact reaction"))?;
+        self.press.update(layout, &self.live, &skin.fusion);
         let speed = point_velocity(model, data, self.ee, &nalgebra::Vector3::zeros())
             .map_err(stage("end-effector velocity"))?
             .norm();
@@ -545,7 +551,7 @@ impl Controller {
         Ok(SupervisorInput {
             ee_speed_mps: speed,
             avoidance_force_n: avoid.force_norm_n,
-            contact_force_n: contact.max_link_n(),
+            contact_force_n: self.press.largest_link_n(),
             goal_error_m: goal_error,
             contact_advance_mps: advance,
         })

@@ -8,6 +8,7 @@ mod approach;
 mod cycle;
 mod hand_force;
 mod io;
+mod press;
 mod setup;
 mod stages;
 mod task_set;

@@ -414,6 +414,7 @@ fn no_skin_point_closes_on_a_sensed_surface_faster_than_the_approach_bound() {
 #[test]
 fn a_push_regulates_its_links_force_under_eps_c() {
     use super::approach::{ApproachBound, ContactIntent, ContactLevels};
+    use super::press::Press;
     use crate::skin::live::LiveCells;
     let config = ControllerConfig::load(&setup("planar7")).unwrap();
     let (model, layout, skin) = (&config.model, &config.layout, &config.skin);
@@ -422,7 +423,8 @@ fn a_push_regulates_its_links_force_under_eps_c() {
     let push_n = levels.push_n;
     assert!(push_n < th.contact_force_n && push_n > th.contact_zero_n, "{push_n}");
     let cells = layout.num_cells();
-    let mut bound = ApproachBound::new(p, levels, skin.force.prepared(), model.nv(), model.nframes(), layout);
+    let mut bound = ApproachBound::new(p, levels, model.nv(), model.nframes(), layout);
+    let mut press = Press::new(skin.force.prepared(), layout, model.nframes());
     let mut limits = bound.limits();
     let mut data = crate::model::ModelData::new(model);
     crate::model::update_kinematics(model, &mut data, &config.setup.posture, &vec![0.0; model.nv()]).unwrap();
@@ -449,7 +451,8 @@ fn a_push_regulates_its_links_force_under_eps_c() {
             })
             .collect();
         let live = LiveCells::from_readings(&readings, &skin.proximity);
-        bound.update(model, &data, layout, &live, &skin.fusion, intent, dt, &mut limits).unwrap();
+        press.update(layout, &live, &skin.fusion);
+        bound.update(model, &data, layout, &live, &press, intent, dt, &mut limits).unwrap();
         let speeds: Vec<f64> = limits.iter().map(|(_, b)| b).collect();
         assert_eq!(speeds.len(), cells, "every touching cell has a limit");
         (speeds[pressed], speeds[beside], speeds[elsewhere])
@@ -564,6 +567,34 @@ fn a_link_squeezed_from_two_sides_has_two_contacts() {
     let apart = contacts.update(layout, [(a, f), (other, g), (near, 0.0)].into_iter()).to_vec();
     assert_relative_eq!(apart[frame].contact_n, f, epsilon = 1e-12);
     assert_relative_eq!(apart[cells[other].frame].contact_n, g, epsilon = 1e-12);
+}
+
+/// The supervisor's `‖F_c‖` is the force on the link pressed hardest, the sum of its contacts:
+/// a link squeezed from opposite sides carries both forces, where the vector sum of its cells
+/// nearly cancels (TOMM's wrist pinched between two obstacles read 4.5 N of MuJoCo's 6.3 N).
+#[test]
+fn the_supervisors_contact_force_sums_a_squeezed_links_contacts() {
+    let mut c = controller("planar7");
+    let config = c.config().clone();
+    let (layout, skin) = (&config.layout, &config.skin);
+    let cells = layout.cells();
+    let a = 0;
+    let on_link = (0..cells.len()).filter(|&i| i != a && cells[i].frame == cells[a].frame);
+    let opposite = on_link
+        .min_by(|&i, &j| {
+            cells[i].normal_link.dot(&cells[a].normal_link).total_cmp(&cells[j].normal_link.dot(&cells[a].normal_link))
+        })
+        .unwrap();
+    let (f, g) = (3.0, 2.5);
+    assert!((f * cells[a].normal_link + g * cells[opposite].normal_link).norm() < 0.5 * (f + g), "opposite cells");
+    let mut readings = vec![CellReading::default(); layout.num_cells()];
+    readings[a] = CellReading::uniform(skin.force.signal(f), 1.0);
+    readings[opposite] = CellReading::uniform(skin.force.signal(g), 1.0);
+    let q = config.setup.posture.clone();
+    let qd = vec![0.0; config.model.nv()];
+    let input = ControllerInput { t_s: 0.0, dt_s: 0.008, q: &q, qd: &qd, cells: &readings, scan: &[] };
+    let fc = c.update(&input).signals.contact_force_n;
+    assert!((fc - (f + g)).abs() < 1e-6, "the link carries {} N, the supervisor read {fc} N", f + g);
 }
 
 /// The supervisor's `contact_advance_mps`: the point where the link pressed hardest is pressed,

@@ -93,6 +93,11 @@ impl LinkContacts {
         }
         &self.links
     }
+
+    /// Per model frame: the link's press of the last [`Self::update`].
+    pub fn links(&self) -> &[LinkForce] {
+        &self.links
+    }
 }
 
 /// The root of `a`'s group (halving the path on the way).

@@ -67,18 +67,8 @@ pub struct ContactSummary {
     pub rows: usize,
     /// Largest task force `F_ci = gain · F_i` \[N\].
     pub max_force_n: f64,
-    /// The link pressed hardest, if any cell is in contact.
+    /// The link pressed hardest (the largest `‖Σ F_i n_i‖`), if any cell is in contact.
     pub pressed: Option<LinkContact>,
-}
-
-impl ContactSummary {
-    /// The supervisor's `‖F_c‖` (Table I): the largest contact force on one link \[N\], the
-    /// norm of the sum of its cells' measured forces `F_i (−n_i)` (0 without contact). A
-    /// contact shared by cells presses its link with their sum; the largest single cell read
-    /// 4.3 N where the link carried 6 N.
-    pub fn max_link_n(&self) -> f64 {
-        self.pressed.map_or(0.0, |p| p.force.norm())
-    }
 }
 
 impl ContactReaction {
@@ -149,7 +139,7 @@ impl ContactReactionParams {
             link.total_n += measured;
         }
         for (frame, link) in links.iter().enumerate().filter(|(_, l)| l.total_n > 0.0) {
-            if link.force.norm() > s.max_link_n() {
+            if link.force.norm() > s.pressed.map_or(0.0, |p| p.force.norm()) {
                 s.pressed = Some(LinkContact { frame, force: link.force, point: link.weighted_points / link.total_n });
             }
         }

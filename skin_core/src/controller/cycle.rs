@@ -3,6 +3,7 @@
 use nalgebra::{DMatrix, DVector, Isometry3};
 
 use super::approach::{ApproachBound, ContactIntent, ContactLevels};
+use super::goal_damping::GoalDamping;
 use super::io::{ControllerInput, ControllerOutput, Fault};
 use super::press::Press;
 use super::setup::{ControllerConfig, HierarchyDynamics, SetupError};
@@ -89,6 +90,10 @@ pub struct Controller {
     tau_k: DVector<f64>,
     tau: DVector<f64>,
     gravity: DVector<f64>,
+    /// [`HierarchyDynamics::AdmittanceInertia`]: the goal's level (configured task index), whose
+    /// executed damping the bias sets.
+    goal_level: Option<usize>,
+    goal_damping: GoalDamping,
     /// [`HierarchyDynamics::Admittance`]: the resolver's virtual inertia and bias `g + C_a v`.
     mass: DMatrix<f64>,
     bias: DVector<f64>,
@@ -189,6 +194,8 @@ impl Controller {
             tau_k: DVector::zeros(nv),
             tau: DVector::zeros(nv),
             gravity: DVector::zeros(nv),
+            goal_level: config.supervisor.tasks.iter().position(|n| n == "goal"),
+            goal_damping: GoalDamping::new(nv),
             mass: DMatrix::zeros(nv, nv),
             bias: DVector::zeros(nv),
             started: false,
@@ -485,6 +492,19 @@ impl Controller {
                     self.mass[(j, j)] = 1.0;
                 }
                 self.bias += &self.gravity;
+                let dynamics = self.config.setup.hierarchy_dynamics;
+                let goal = self.goal_level.filter(|g| order.contains(g) && self.tasks.levels[*g].rows() == 3);
+                if let Some(g) = goal.filter(|_| dynamics == HierarchyDynamics::AdmittanceInertia) {
+                    let damping = self.goal_damping.damping_torque_mut();
+                    self.resolver.virtual_damping(input.q, input.qd, input.dt_s, damping);
+                    for (d, _) in damping.iter_mut().zip(&self.locked).filter(|(_, &l)| l) {
+                        *d = 0.0;
+                    }
+                    let (jt, goal_params) = (self.tasks.levels[g].jacobian_transpose(), &self.config.tasks.goal);
+                    if !self.goal_damping.add(jt, &self.mass, input.qd, goal_params, &mut self.bias) {
+                        return Err(Fault::Stage("goal damping"));
+                    }
+                }
                 self.clock.lap(Stage::Dynamics);
                 self.solver.solve(&self.mass, active, posture, Some(self.bias.as_slice()), &mut self.tau_k)
             }

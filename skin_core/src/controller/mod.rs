@@ -6,6 +6,7 @@
 
 mod approach;
 mod cycle;
+mod goal_damping;
 mod hand_force;
 mod io;
 mod press;

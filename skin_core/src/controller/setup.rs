@@ -83,7 +83,8 @@ pub enum HierarchyDynamics {
     /// the resolver's `C_a` to damp the rest. The resolver executes `M_a q̈ + C_a q̇ = τ* − g`; with
     /// `C_a` proportional to `M_a` on the moving joints (as shipped: 10 / 0.5 on every arm joint)
     /// a lower level then moves nothing a higher level controls, in the acceleration and in the
-    /// steady velocity (`docs/controller.md`: the projection leak).
+    /// steady velocity (`docs/controller.md`: the projection leak). In the goal's range the bias
+    /// also replaces `C_a` with the goal's own damping (`controller::goal_damping`).
     AdmittanceInertia,
 }
 

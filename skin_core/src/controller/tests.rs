@@ -625,3 +625,45 @@ fn contact_advance_is_the_pressed_points_speed_into_its_contact() {
     let input = ControllerInput { t_s: 0.016, dt_s: 0.008, q: &q, qd: &row, cells: &quiet, scan: &[] };
     assert!(c.update(&input).signals.contact_advance_mps.is_nan(), "no contact");
 }
+
+/// Near TOMM's reach the goal of intentional-contact paper eq. (7)-(9) moves the hand as the
+/// paper's law does: at most `V_max`, into the tolerance without overshoot. The resolver's joint
+/// damping `C_a` held it there to a crawl of millimetres per second, 5.7 cm short after 12 s
+/// (`controller::goal_damping`). From the `tomm_movable_obstacles` start, its goal 0.5 m away at
+/// the edge of the right arm's reach; a perfectly tracking arm, no skin contact.
+#[test]
+fn tomm_reaches_a_goal_at_its_reach_at_the_goals_speed() {
+    let mut c = controller("tomm");
+    let model = c.config().model.clone();
+    let goal_params = c.config().tasks.goal;
+    let mut q = c.config().setup.posture.clone();
+    let start = [
+        ("right_shoulder_pan_joint", 2.598),
+        ("right_shoulder_lift_joint", 0.602),
+        ("right_elbow_joint", -0.924),
+        ("right_wrist_1_joint", -1.642),
+        ("right_wrist_2_joint", 2.288),
+        ("right_wrist_3_joint", 0.984),
+    ];
+    for (name, value) in start {
+        q[model.joint_index(name).unwrap()] = value;
+    }
+    let mut qd = vec![0.0; model.nv()];
+    let cells = vec![CellReading::default(); c.config().layout.num_cells()];
+    let goal = Vector3::new(0.75, -0.85, 0.9);
+    c.set_goal(Some(Isometry3::from_parts(Translation3::from(goal), UnitQuaternion::identity()))).unwrap();
+    let dt = 0.008;
+    let (mut fastest, mut closest) = (0.0_f64, f64::INFINITY);
+    for k in 0..1500 {
+        let out = c.update(&ControllerInput { t_s: k as f64 * dt, dt_s: dt, q: &q, qd: &qd, cells: &cells, scan: &[] });
+        assert_eq!(out.fault, None);
+        fastest = fastest.max(out.signals.ee_speed_mps);
+        closest = closest.min(out.signals.goal_error_m);
+        follow(&c, &mut q, &mut qd, dt);
+    }
+    let e = c.output().signals.goal_error_m;
+    let tolerance = c.config().supervisor.thresholds.goal_tolerance_m;
+    assert!(fastest <= 1.05 * goal_params.v_max_m_per_s, "at most V_max: {fastest} m/s");
+    assert!(e <= tolerance, "within the goal tolerance after 12 s: {e} m");
+    assert!(e <= closest + 5e-4, "no overshoot: {e} m at the end, {closest} m at the closest");
+}

@@ -4,6 +4,7 @@
 use skin_core::controller::HandForceMap;
 use skin_core::model::{update_kinematics, ModelData};
 use skin_core::supervisor::Mode;
+use skin_sim::outputs::metrics::TOPPLED_DEG;
 use skin_sim::run::runner::RunTarget;
 use skin_sim::run::scenario::{self, SCENARIOS};
 use skin_sim::scene::RunOverrides;
@@ -88,6 +89,10 @@ fn intentional_contact_passes_every_outcome_check() {
     // the obstacle below eps_c, reaches the goal and relieves the hard push within 0.5 s.
     let report = passes_paper_000_checks("intentional_contact", 20.0);
     assert!(report.checks.iter().any(|c| c.name == "hard push relieved"), "the push reaches the arm");
+    // The planar arm acts in its plane: the obstacle slides, the hand's push tips it no more than
+    // it did the paper's (a bare 12 N force threw it along the arm at 3-4 m/s and toppled it).
+    let tilt = report.metrics.goal.as_ref().unwrap().object_tilt_max_deg;
+    assert!(tilt < TOPPLED_DEG, "the obstacle toppled: {tilt:.0}°");
 }
 
 #[test]

@@ -105,6 +105,31 @@ fn the_person_follows_its_path() {
     assert_eq!(w.body_position("p").unwrap(), [1.0, 1.0, -0.3]);
 }
 
+/// An object pushed by a hand of `max_speed_mps` (none: a bare force): its speed along the push
+/// after `t` s of a 12 N push on 0.5 kg with 1 N of friction, away from the arm.
+fn pushed_speed(max_speed_mps: Option<f64>, t: f64) -> f64 {
+    let hand = max_speed_mps.map_or(String::new(), |v| format!(", max_speed_mps: {v}"));
+    let mut w = world(&planar7(&format!(
+        "objects:\n  - {{name: b, shape: {{cylinder: {{radius_m: 0.1, length_m: 0.6}}}}, xyz: [0.0, -1.0, 0.0], \
+         mass_kg: 0.5, friction: 0.2}}\npushes: [{{object: b, force_n: [0.0, -12.0, 0.0], start_s: 0.0, end_s: 2.0{hand}}}]\n"
+    )));
+    run(&mut w, t);
+    let y0 = w.body_position("b").unwrap()[1];
+    run(&mut w, 0.1);
+    (y0 - w.body_position("b").unwrap()[1]) / 0.1
+}
+
+#[test]
+fn a_push_follows_its_object_at_the_hands_speed() {
+    // 22 m/s² bare: 10 m/s after half a second.
+    assert!(pushed_speed(None, 0.4) > 8.0);
+    for v in [0.3, 1.0] {
+        let s = pushed_speed(Some(v), 0.4);
+        // The hand keeps up against the friction, and lets go within a step (12 N on 0.5 kg: 0.024 m/s).
+        assert!(s > 0.9 * v && s < v + 0.03, "hand at {v} m/s: the object at {s} m/s");
+    }
+}
+
 fn invalid(yaml: &str) -> String {
     match Scene::from_yaml_str(yaml, "bad.yaml", &scenes_dir()) {
         Err(e) => e.to_string(),
@@ -133,6 +158,8 @@ fn scene_errors_name_the_file_and_the_key() {
     assert!(e.contains("`pushes[0]`"), "{e}");
     let e = invalid(&planar7("pushes: [{link: link3, force_n: [1, 0, 0], start_s: 0, end_s: 1, ramp_s: 0.6}]\n"));
     assert!(e.contains("`pushes[0].ramp_s`"), "{e}");
+    let e = invalid(&planar7("pushes: [{link: link3, force_n: [1, 0, 0], start_s: 0, end_s: 1, max_speed_mps: 0}]\n"));
+    assert!(e.contains("`pushes[0].max_speed_mps`"), "{e}");
     let circle = "{start_s: 1, end_s: 19, circle: {radius_m: 0.2, period_s: 5}}";
     let e = invalid(&planar7(&format!("base_motions: [{circle}]\n")));
     assert!(e.contains("`base_motions`") && e.contains("does not move"), "{e}");

@@ -55,6 +55,16 @@ pub fn resistance_n(spec: &SceneSpec, pushed: &[&str]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// An obstacle pushed at height `h` above the floor slides rather than tips when `μ h < r`
+/// (`r` its radius: the push's moment about the edge it would tip over against its weight's);
+/// the planar family keeps its friction at most this share of that limit, a margin for the
+/// impacts of a push (`docs/supervisor.md`: over it obstacles toppled, out of the arm's plane).
+/// A friction drawn over it is clamped to it: the scenes under it stay what they were.
+pub(super) const TIP_MARGIN: f64 = 0.8;
+
+/// Radius of the planar family's second obstacle \[m\].
+const SECOND_RADIUS_M: f64 = 0.05;
+
 /// Movable with probability `1 - p_fixed`: a mass in `[lo, hi]` kg, or fixed (`None`).
 fn mass(rng: &mut Noise, p_fixed: f64, lo: f64, hi: f64) -> Option<f64> {
     (rng.uniform() > p_fixed).then(|| rng.between(lo, hi))
@@ -67,8 +77,10 @@ fn planar_contact(rng: &mut Noise, spec: &mut SceneSpec) -> Value {
     let (dx, dy) = (rng.between(-0.08, 0.08), rng.between(-0.03, 0.05));
     let radius = rng.between(0.07, 0.12);
     let mass_kg = mass(rng, 0.2, 0.2, 3.0);
-    let friction = rng.between(0.1, 0.4);
     let obstacle = &mut spec.objects[0];
+    let sliding = |r: f64| TIP_MARGIN * r / (obstacle.xyz[2] - spec.floor_z_m);
+    let friction = rng.between(0.1, 0.4).min(sliding(radius));
+    let second_friction = friction.min(sliding(SECOND_RADIUS_M));
     obstacle.xyz[0] += dx;
     obstacle.xyz[1] += dy - (radius - 0.1); // the same gap to the goal below it
     obstacle.shape = ShapeSpec::Cylinder { radius_m: radius, length_m: 0.6 };
@@ -82,7 +94,8 @@ fn planar_contact(rng: &mut Noise, spec: &mut SceneSpec) -> Value {
         let side = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
         let mut o: ObjectSpec = spec.objects[0].clone();
         o.name = "second_obstacle".into();
-        o.shape = ShapeSpec::Cylinder { radius_m: 0.05, length_m: 0.6 };
+        o.shape = ShapeSpec::Cylinder { radius_m: SECOND_RADIUS_M, length_m: 0.6 };
+        o.friction = second_friction;
         o.xyz = [1.0 + side * rng.between(0.25, 0.35), -0.62, 0.0];
         o.mass_kg = Some(0.5);
         spec.objects.push(o);

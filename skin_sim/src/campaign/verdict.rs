@@ -3,6 +3,7 @@
 
 use serde::Serialize;
 
+pub use crate::outputs::metrics::TOPPLED_DEG;
 use crate::outputs::outcome::FIRST_CONTACT_OVERSHOOT_N;
 use crate::outputs::report::RunReport;
 use crate::outputs::safety;
@@ -18,6 +19,9 @@ pub struct Verdict {
     /// Goal scenes: the goal was reached, and before the first push on an object when there is
     /// one (a goal that only the push cleared the way to was not reached by the controller).
     pub goal_reached: Option<bool>,
+    /// Goal scenes: the largest tilt of a movable object from its start orientation \[deg\]
+    /// (over [`TOPPLED_DEG`] one toppled).
+    pub object_tilt_max_deg: Option<f64>,
     /// Force scenes: the Table 3 checks held.
     pub force_table3: Option<bool>,
     /// Force scenes: largest hand force over its reference at the first touch \[N\].
@@ -34,8 +38,16 @@ pub fn judge(report: &RunReport) -> Verdict {
         violations: safety::violations(&m.safety, m.faulted_cycles),
         outcome: m.goal.as_ref().map(|g| g.outcome),
         goal_reached: m.goal.as_ref().map(|g| g.goal_reached && g.reached_before_pushes()),
+        object_tilt_max_deg: m.goal.as_ref().map(|g| g.object_tilt_max_deg),
         force_table3,
         first_contact_overshoot_n: m.force.as_ref().map(|f| f.first_contact_peak_force_n - f.first_contact_reference_n),
+    }
+}
+
+impl Verdict {
+    /// Whether a movable object of the scene toppled.
+    pub fn toppled(&self) -> bool {
+        self.object_tilt_max_deg.is_some_and(|t| t > TOPPLED_DEG)
     }
 }
 

@@ -23,6 +23,8 @@ pub const RECOVERY_LIMIT_S: f64 = 0.5;
 /// The hand force must reach its reference within this time after the first touch \[s\]: the
 /// rise the from-reach RMS leaves out is bounded (measured 0.46-1.85 s with the approach bound).
 pub const FORCE_RISE_LIMIT_S: f64 = 2.0;
+/// An object tilted further than this from its start orientation toppled \[deg\].
+pub const TOPPLED_DEG: f64 = 45.0;
 
 /// A run's wall-clock time by part \[s\].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -147,6 +149,9 @@ pub struct GoalMetrics {
     pub outcome: &'static str,
     /// When the supervisor first held the arm as blocked \[s\] (null: never).
     pub blocked_at_s: f64,
+    /// Largest tilt of a movable object from its start orientation over the run \[deg\]: over
+    /// [`TOPPLED_DEG`] an obstacle toppled, which a planar scene does not model.
+    pub object_tilt_max_deg: f64,
 }
 
 impl GoalMetrics {
@@ -312,6 +317,7 @@ fn goal_metrics(cycles: &[CycleRecord], pushes: &[(f64, f64)], limits: &Limits) 
             _ => "not_reached",
         },
         blocked_at_s: cycles.iter().find(|c| c.blocked.is_some()).map_or(f64::NAN, |c| c.t_s),
+        object_tilt_max_deg: cycles.iter().map(|c| c.object_tilt_deg).fold(0.0, f64::max),
     }
 }
 

@@ -163,6 +163,7 @@ mod tests {
                 hard_contact_recovery_s: f64::NAN,
                 outcome,
                 blocked_at_s: f64::NAN,
+                object_tilt_max_deg: 0.0,
             }),
             force: None,
             contact_free: None,

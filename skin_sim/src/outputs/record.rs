@@ -49,6 +49,9 @@ pub struct CycleRecord {
     /// Distance ahead of the palm (along `+z_h`) to the first object or person, from MuJoCo \[m\]
     /// (infinite: nothing ahead).
     pub hand_distance_m: f64,
+    /// Largest tilt of a movable object from its start orientation, from MuJoCo \[deg\]: over
+    /// 45° an obstacle toppled (a planar scene's obstacle left the plane it models).
+    pub object_tilt_deg: f64,
     /// `ʰΓ`, the hand skin's moment in the hand frame that the controller computed (interactive-force-control paper
     /// eq. 10; normalized-signal units times metres); NaN when the controller ran elsewhere (the ROS
     /// graph does not publish it).
@@ -96,6 +99,7 @@ impl CycleRecord {
             link_force_n: force_n,
             hand_position_m: [0.0; 3],
             hand_distance_m: 0.0,
+            object_tilt_deg: 0.0,
             hand_moment: [0.0; 3],
             force_reference_n: f64::NAN,
             force_reference_signal: 0.0,

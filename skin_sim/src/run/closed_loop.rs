@@ -193,6 +193,7 @@ impl ClosedLoop {
             link_force_n: forces.max_link_n,
             hand_position_m: forces.hand_position_m,
             hand_distance_m: forces.hand_distance_m,
+            object_tilt_deg: forces.object_tilt_deg,
             hand_moment: out.hand_moment.into(),
             force_reference_n: scheduled.force_n,
             force_reference_signal: scheduled.force_signal,

@@ -212,6 +212,7 @@ impl ExternalRun {
             link_force_n: forces.max_link_n,
             hand_position_m: forces.hand_position_m,
             hand_distance_m: forces.hand_distance_m,
+            object_tilt_deg: forces.object_tilt_deg,
             hand_moment: [f64::NAN; 3],
             force_reference_n,
             force_reference_signal,

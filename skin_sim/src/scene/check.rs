@@ -256,6 +256,9 @@ fn check_push(key: &str, p: &PushSpec, objects: &[ObjectSpec]) -> Checked {
     finite(format!("{key}.force_n"), &p.force_n)?;
     finite(format!("{key}.point_m"), &p.point_m)?;
     non_negative(format!("{key}.ramp_s"), p.ramp_s)?;
+    if let Some(v) = p.max_speed_mps {
+        positive(format!("{key}.max_speed_mps"), v)?;
+    }
     window(key, p.start_s, p.end_s, p.ramp_s)?;
     match (&p.object, &p.link) {
         (Some(o), None) => {

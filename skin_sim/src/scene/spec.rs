@@ -363,6 +363,12 @@ pub struct PushSpec {
     /// ramps linearly from 0 over the window's first and last `ramp_s`); 0: a step.
     #[serde(default)]
     pub ramp_s: f64,
+    /// Speed of the hand that pushes \[m/s\]: the force acts only while the pushed point moves
+    /// slower than this along it (a person pushing an object into the arm, intentional-contact
+    /// paper Fig. 2d, follows it at a hand's speed; an unbounded force on an object that meets
+    /// nothing throws it). None: the force acts whatever the speed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_speed_mps: Option<f64>,
 }
 
 /// The fraction of a push's force acting at time `t`: 0 outside `[start_s, end_s)`, ramping

@@ -101,22 +101,36 @@ struct Push {
     start_s: f64,
     end_s: f64,
     ramp_s: f64,
+    max_speed_mps: Option<f64>,
 }
 
 impl Push {
-    /// The force acting at time `t` (world) \[N\].
-    fn force_at(&self, t: f64) -> Vector3<f64> {
-        self.force * push_scale(t, self.start_s, self.end_s, self.ramp_s)
+    /// The force acting now (world) \[N\]: none once the pushed point moves along it at the
+    /// hand's speed ([`crate::scene::spec::PushSpec::max_speed_mps`]).
+    fn force_now(&self, data: &MjData<Box<MjModel>>) -> Vector3<f64> {
+        let force = self.force * push_scale(data.time(), self.start_s, self.end_s, self.ramp_s);
+        let outrun = self.max_speed_mps.is_some_and(|v_max| {
+            // Rotation then translation, at the body's centre of mass, world axes.
+            let v = data.object_velocity(MjtObjBase::mjOBJ_BODY, self.body, false);
+            let lever = (body_pose(data, self.body) * self.point).coords - Vector3::from(data.xipos()[self.body]);
+            let velocity = Vector3::new(v[3], v[4], v[5]) + Vector3::new(v[0], v[1], v[2]).cross(&lever);
+            force.norm() > 0.0 && velocity.dot(&force.normalize()) >= v_max
+        });
+        if outrun {
+            Vector3::zeros()
+        } else {
+            force
+        }
     }
 }
 
 /// The pushes acting now, as the skin feels them (pushes on objects touch no cell).
 fn touches(pushes: &[Push], data: &MjData<Box<MjModel>>) -> Vec<Touch> {
-    let t = data.time();
     pushes
         .iter()
-        .filter(|p| p.force_at(t) != Vector3::zeros())
-        .map(|p| Touch { body: p.body, point: body_pose(data, p.body) * p.point, force: p.force_at(t) })
+        .map(|p| (p, p.force_now(data)))
+        .filter(|(_, force)| *force != Vector3::zeros())
+        .map(|(p, force)| Touch { body: p.body, point: body_pose(data, p.body) * p.point, force })
         .collect()
 }
 
@@ -136,6 +150,8 @@ pub struct World {
     pushes: Vec<Push>,
     /// Mocap index of each scene person.
     persons: Vec<usize>,
+    /// Each movable object's body and its z axis at the start (world): how far it tipped.
+    movable: Vec<(usize, Vector3<f64>)>,
     skin: Option<SkinSensor>,
     lidar: Option<Lidar>,
     steps: u64,
@@ -215,10 +231,13 @@ impl World {
                     start_s: p.start_s,
                     end_s: p.end_s,
                     ramp_s: p.ramp_s,
+                    max_speed_mps: p.max_speed_mps,
                 }
             })
             .collect();
         let persons = scene.spec.persons.iter().map(|p| mj.body_mocapid()[body(&p.name)] as usize).collect();
+        let movable: Vec<usize> =
+            scene.spec.objects.iter().filter(|o| o.mass_kg.is_some()).map(|o| body(&o.name)).collect();
         let skin = SkinSensor::new(&scene, &mj);
         let lidar = Lidar::new(&scene, &mj);
         let spec = &scene.spec;
@@ -234,6 +253,7 @@ impl World {
             twist: [0.0; 3],
             pushes,
             persons,
+            movable: Vec::new(),
             skin,
             lidar,
             steps: 0,
@@ -251,8 +271,21 @@ impl World {
         }
         world.apply_inputs();
         world.data.forward();
+        world.movable = movable.into_iter().map(|b| world.body_axis_z(b)).collect();
         world.sample_sensors();
         Ok(world)
+    }
+
+    /// Body `b` and its z axis now (world).
+    fn body_axis_z(&self, b: usize) -> (usize, Vector3<f64>) {
+        (b, body_pose(&self.data, b).rotation * Vector3::z())
+    }
+
+    /// The largest tilt of a movable object from its start orientation \[deg\] (0 without
+    /// any): over 45° a standing obstacle toppled, which a planar scene does not model.
+    pub fn object_tilt_deg(&self) -> f64 {
+        let tilt = |&(b, z0): &(usize, Vector3<f64>)| self.body_axis_z(b).1.angle(&z0).to_degrees();
+        self.movable.iter().map(tilt).fold(0.0, f64::max)
     }
 
     /// The scene the world was built from.
@@ -402,7 +435,7 @@ impl World {
         }
         for k in 0..self.pushes.len() {
             let p = self.pushes[k];
-            let force = p.force_at(t);
+            let force = p.force_now(&self.data);
             if force == Vector3::zeros() {
                 continue;
             }

@@ -18,6 +18,7 @@ use serde::Serialize;
 use serde_json::Value;
 
 use crate::outputs::artifacts::FigurePng;
+use crate::outputs::metrics::TOPPLED_DEG;
 use crate::outputs::report::{write_all, MetricsJson, SummaryText};
 use crate::run::runner::RunTarget;
 use crate::run::scenario;
@@ -27,7 +28,7 @@ use crate::study::pool;
 use crate::world::noise::Noise;
 use families::{Family, EPS_C_N, FAMILIES};
 pub use result::SceneResult;
-use verdict::{judge, overshoot_ok, TOPPLED_DEG};
+use verdict::{judge, overshoot_ok};
 
 /// One generated scene.
 #[derive(Debug, Clone)]

@@ -3,7 +3,7 @@
 
 use serde::Serialize;
 
-pub use crate::outputs::metrics::TOPPLED_DEG;
+use crate::outputs::metrics::TOPPLED_DEG;
 use crate::outputs::outcome::FIRST_CONTACT_OVERSHOOT_N;
 use crate::outputs::report::RunReport;
 use crate::outputs::safety;

@@ -5,6 +5,7 @@
 //! and the physical contact forces of the [`probe`], with seeded [`noise`].
 
 mod cell_face;
+mod contact_patches;
 mod frames;
 pub mod lidar;
 pub mod mjcf;

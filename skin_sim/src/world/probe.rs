@@ -6,6 +6,7 @@
 use mujoco_rs::mujoco_c;
 use nalgebra::Vector3;
 
+use crate::world::contact_patches::{self, ContactPatch};
 use crate::world::frames::FrameRef;
 use crate::world::mjcf::{ROBOT_GROUP, SENSED_GROUPS};
 use crate::world::World;
@@ -33,9 +34,8 @@ pub struct ContactProbe {
     hand_frame: usize,
     /// Scratch: total normal force per MuJoCo body.
     per_body: Vec<f64>,
-    /// Scratch: the summed force of each robot body's contacts with one other geom (body, geom,
-    /// force on the robot).
-    pairs: Vec<(usize, usize, Vector3<f64>)>,
+    /// Scratch: the contacts per robot body and other geom.
+    patches: Vec<ContactPatch>,
 }
 
 impl ContactProbe {
@@ -45,49 +45,25 @@ impl ContactProbe {
             hand: FrameRef::new(&world.scene().model, world.mj_model(), hand_frame),
             hand_frame,
             per_body: vec![0.0; world.mj_model().ffi().nbody as usize],
-            pairs: Vec::new(),
+            patches: Vec::new(),
         }
     }
 
-    /// The forces of the world's current contacts: every contact between a robot geom and the
-    /// environment (objects, persons, floor) contributes its normal force (`mj_contactForce`),
-    /// summed as vectors per robot body and other geom (as the skin takes them: two overlapping
-    /// geoms of a link that MuJoCo at times gives opposite normals squeeze nothing), then by
-    /// magnitude per body (a link pinched between two objects bears both).
+    /// The forces of the world's current contacts between the robot and the environment (objects,
+    /// persons, floor): per robot body and other geom as the skin takes them ([`contact_patches`]),
+    /// then by magnitude per body (a link pinched between two objects bears both).
     pub fn measure(&mut self, world: &World) -> ProbeReadings {
         let (model, data) = (world.mj_model(), world.mj_data());
-        let (group, geom_body) = (model.geom_group(), model.geom_bodyid());
+        let group = model.geom_group();
         let hand = world.frame_pose(self.hand_frame);
         let z_hand = hand.rotation * Vector3::z();
         self.per_body.fill(0.0);
-        self.pairs.clear();
-        for (k, con) in data.contact().iter().enumerate() {
-            let [g1, g2] = [con.geom1 as usize, con.geom2 as usize];
-            let robot = |g: usize| group[g] == ROBOT_GROUP as i32;
-            if robot(g1) == robot(g2) {
-                continue; // self-contact or environment only
-            }
-            let mut f = [0.0; 6];
-            // SAFETY: model and data belong together and k < ncon.
-            unsafe { mujoco_c::mj_contactForce(model.ffi(), data.ffi(), k as i32, &mut f) };
-            if f[0] <= 0.0 {
-                continue;
-            }
-            // The normal points from geom1 to geom2; the force pushes geom2 along it.
-            let normal = Vector3::new(con.frame[0], con.frame[1], con.frame[2]) * f[0];
-            let (body, other, on_robot) =
-                if robot(g1) { (geom_body[g1], g2, -normal) } else { (geom_body[g2], g1, normal) };
-            let body = body as usize;
-            match self.pairs.iter_mut().find(|(b, o, _)| (*b, *o) == (body, other)) {
-                Some((_, _, f)) => *f += on_robot,
-                None => self.pairs.push((body, other, on_robot)),
-            }
-        }
+        contact_patches::collect(data, &mut self.patches);
         let mut hand_n = 0.0;
-        for &(body, _, on_robot) in &self.pairs {
-            self.per_body[body] += on_robot.norm();
-            if body == self.hand.body {
-                hand_n += (-on_robot.dot(&z_hand)).max(0.0);
+        for p in self.patches.iter().filter(|p| group[p.other] != ROBOT_GROUP as i32) {
+            self.per_body[p.body] += p.force.norm();
+            if p.body == self.hand.body {
+                hand_n += (-p.force.dot(&z_hand)).max(0.0);
             }
         }
         let origin = hand.translation.vector;

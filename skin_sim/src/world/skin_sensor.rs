@@ -26,7 +26,6 @@
 
 use std::ops::Range;
 
-use mujoco_rs::mujoco_c;
 use mujoco_rs::prelude::*;
 use mujoco_rs::wrappers::mj_model::traits::ModelType;
 use nalgebra::{Point3, Vector3};
@@ -35,8 +34,8 @@ use skin_core::skin::signals::CellReading;
 
 use crate::scene::Scene;
 use crate::world::cell_face::CellFace;
+use crate::world::contact_patches::{self, ContactPatch};
 use crate::world::frames::{body_pose, FrameRef};
-use crate::world::mjcf::ROBOT_GROUP;
 use crate::world::noise::Noise;
 use crate::world::proximity_rays::ProximityRays;
 
@@ -48,20 +47,6 @@ struct SimCell {
     normal: Vector3<f64>,
     face: CellFace,
     active: bool,
-}
-
-/// The contacts of one robot body with one other geom in a sample.
-#[derive(Debug, Clone, Copy)]
-struct ContactPatch {
-    /// The geom the robot body touches.
-    other: usize,
-    /// MuJoCo body of the robot.
-    body: usize,
-    /// Summed force on the robot body (world) \[N\].
-    force: Vector3<f64>,
-    /// Box spanned by the contact points (world axes).
-    min: Point3<f64>,
-    max: Point3<f64>,
 }
 
 /// The skin of a [`crate::world::World`]; readings are indexed like the scene layout's cells.
@@ -231,43 +216,13 @@ impl SkinSensor {
 
     /// Fills `force_n` with each cell's share of the normal contact forces on the robot. MuJoCo
     /// reports a flat contact between two boxes as the corners of the touching area, so the
-    /// contacts of one robot body with one other geom are taken together: their summed force is
-    /// shared by the cells near the box spanned by their points (a flat palm on a board: every
-    /// palm cell; an edge: the cells along it; one point: the cells around it). Summed over the
-    /// body's geoms, not per geom: where two of a link's geoms overlap (planar7's cylinder and
-    /// its end cap), MuJoCo at times gives one of them a flipped normal, and the pair squeezes
-    /// the object with 70 N each way for a step, which the body as a whole does not feel.
+    /// contacts of one robot body with one other geom are taken together ([`contact_patches`]):
+    /// their summed force is shared by the cells near the box spanned by their points (a flat
+    /// palm on a board: every palm cell; an edge: the cells along it; one point: the cells around
+    /// it).
     fn contact_forces<M: ModelType>(&mut self, data: &MjData<M>) {
         self.force_n.fill(0.0);
-        self.patches.clear();
-        let model = data.model();
-        let (group, geom_body) = (model.geom_group(), model.geom_bodyid());
-        for (k, con) in data.contact().iter().enumerate() {
-            let [g1, g2] = [con.geom1 as usize, con.geom2 as usize];
-            let mut force = [0.0; 6];
-            // SAFETY: model and data belong together and k < ncon.
-            unsafe { mujoco_c::mj_contactForce(model.ffi(), data.ffi(), k as i32, &mut force) };
-            if force[0] <= 0.0 {
-                continue;
-            }
-            // The contact normal points from geom1 to geom2; the force pushes geom2 along it.
-            let normal = Vector3::new(con.frame[0], con.frame[1], con.frame[2]) * force[0];
-            let pos = Point3::from(con.pos);
-            for (g, other, f) in [(g1, g2, -normal), (g2, g1, normal)] {
-                if group[g] != ROBOT_GROUP as i32 {
-                    continue;
-                }
-                let body = geom_body[g] as usize;
-                match self.patches.iter_mut().find(|p| p.body == body && p.other == other) {
-                    Some(p) => {
-                        p.force += f;
-                        p.min = p.min.inf(&pos);
-                        p.max = p.max.sup(&pos);
-                    }
-                    None => self.patches.push(ContactPatch { other, body, force: f, min: pos, max: pos }),
-                }
-            }
-        }
+        contact_patches::collect(data, &mut self.patches);
         for k in 0..self.patches.len() {
             let p = self.patches[k];
             self.distribute(data, &p);
@@ -355,8 +310,10 @@ impl SkinSensor {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::world::mjcf::ROBOT_GROUP;
     use crate::world::mjcf::SENSED_GROUPS;
     use crate::World;
+    use mujoco_rs::mujoco_c;
     use nalgebra::Isometry3;
 
     /// Culling by body, in the body's frame, changes no reading: every cell's proximity distance
